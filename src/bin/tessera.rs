@@ -1,1 +1,230 @@
-fn main() {}
+//! The `tessera` command line: a thin layer over the library.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use tessera::io::points::SphereFormat;
+use tessera::tiling::sphere::SphereTiling;
+use tessera::{engine, Error};
+
+#[derive(Parser)]
+#[command(
+    name = "tessera",
+    version,
+    about = "Blue-noise importance sampling with self-similar tilings"
+)]
+struct Cli {
+    /// Worker threads (default: all cores). The output does not depend on it.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Sample the unit sphere (HEALPix faces tiled by P-pentominoes).
+    Sphere(SphereArgs),
+    /// Draw a tiling level and its samples as SVG.
+    Tiles(TilesArgs),
+    /// Build the offline tables in luts/.
+    Lut {
+        #[command(subcommand)]
+        command: LutCommand,
+    },
+}
+
+#[derive(Args)]
+struct SphereArgs {
+    /// Importance: `uniform` or `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
+    /// density CONTRAST inside the cap, 1 outside).
+    #[arg(long, default_value = "uniform")]
+    density: String,
+    /// Number of samples (exact unless --expected).
+    #[arg(short = 'n', long = "count")]
+    count: usize,
+    /// Skip the exactness pass: return the natural count near N.
+    #[arg(long)]
+    expected: bool,
+    /// Output file, `-` for standard output.
+    #[arg(short, long, default_value = "-")]
+    output: PathBuf,
+    /// xyz: `x y z` per line; lonlat: `lon lat` degrees; csv: header and a pdf
+    /// column; bin: UTK binary (f64, 3 dimensions).
+    #[arg(long, default_value = "xyz")]
+    format: String,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum System {
+    Sphere,
+}
+
+#[derive(Args)]
+struct TilesArgs {
+    /// Tile system to draw.
+    #[arg(long, value_enum)]
+    system: System,
+    /// Subdivision level (0..=5).
+    #[arg(long, default_value_t = 0)]
+    level: u32,
+    /// SVG file to write.
+    #[arg(long)]
+    svg: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum LutCommand {
+    /// Run the offline optimiser and write the table and its provenance.
+    Build(LutBuildArgs),
+}
+
+#[derive(Args)]
+struct LutBuildArgs {
+    /// Tile system whose table to build.
+    #[arg(long, value_enum)]
+    system: System,
+    /// Seed of every random choice (the build is deterministic for a seed).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Lloyd iterations per level and importance bin.
+    #[arg(long, default_value_t = 8)]
+    iterations: usize,
+    /// Directory to write `<system>.lut` and `<system>.provenance.json` into.
+    #[arg(long, default_value = "luts")]
+    out_dir: PathBuf,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(threads) = cli.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build_global()
+        {
+            eprintln!("tessera: cannot start {threads} threads: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let result = match cli.command {
+        Command::Sphere(args) => sphere(args),
+        Command::Tiles(args) => tiles(args),
+        Command::Lut {
+            command: LutCommand::Build(args),
+        } => lut_build(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("tessera: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
+    if path == Path::new("-") {
+        return Ok(Box::new(std::io::BufWriter::new(std::io::stdout().lock())));
+    }
+    let file = std::fs::File::create(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    Ok(Box::new(std::io::BufWriter::new(file)))
+}
+
+fn io_error(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |source| Error::Io {
+        path: path.into(),
+        source,
+    }
+}
+
+fn sphere(args: SphereArgs) -> Result<(), Error> {
+    let format: SphereFormat = args.format.parse()?;
+    let density = tessera::density::sphere::parse(&args.density)?;
+    let tiling = SphereTiling::default();
+    let samples = engine::generate(&tiling, &density, args.count, !args.expected)?;
+    let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
+    let mut out = create(&args.output)?;
+    tessera::io::points::write_sphere(&mut out, &points, format, |p| {
+        engine::pdf(&tiling, &density, p)
+    })
+    .and_then(|()| out.flush())
+    .map_err(io_error(&args.output))
+}
+
+fn tiles(args: TilesArgs) -> Result<(), Error> {
+    match args.system {
+        System::Sphere => {
+            if args.level > 5 {
+                return Err(Error::Request(format!(
+                    "level {} draws {} tiles; at most level 5 is drawn",
+                    args.level,
+                    240u64 << (2 * args.level)
+                )));
+            }
+            let tiling = SphereTiling::default();
+            let count = 240usize << (2 * args.level);
+            let points: Vec<glam::DVec3> =
+                engine::generate(&tiling, &tessera::density::Uniform, count, true)?
+                    .iter()
+                    .map(|s| s.position)
+                    .collect();
+            let svg = tessera::io::svg::sphere_tiles(&tiling, args.level, &points);
+            std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
+        }
+    }
+}
+
+fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
+    match args.system {
+        System::Sphere => {
+            let options = tessera::optimize::sphere::BuildOptions {
+                seed: args.seed,
+                iterations: args.iterations,
+                ..Default::default()
+            };
+            let bar = ProgressBar::new(1);
+            bar.set_style(
+                ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
+                    .expect("static template"),
+            );
+            let progress = |stage: &str, done: u64, total: u64| {
+                bar.set_message(stage.to_string());
+                bar.set_length(total);
+                bar.set_position(done);
+            };
+            let started = std::time::Instant::now();
+            let (lut, report) = tessera::optimize::sphere::build(&options, &progress)?;
+            bar.finish();
+            let seconds = started.elapsed().as_secs_f64();
+            std::fs::create_dir_all(&args.out_dir).map_err(io_error(&args.out_dir))?;
+            let table = args.out_dir.join("sphere.lut");
+            std::fs::write(&table, lut.to_bytes()).map_err(io_error(&table))?;
+            let provenance = serde_json::json!({
+                "command": std::env::args().collect::<Vec<_>>().join(" "),
+                "tessera_version": env!("CARGO_PKG_VERSION"),
+                "format_version": lut.version,
+                "options": options,
+                "build_seconds": seconds,
+                "report": report,
+                "table_bytes": lut.to_bytes().len(),
+            });
+            let path = args.out_dir.join("sphere.provenance.json");
+            std::fs::write(
+                &path,
+                serde_json::to_string_pretty(&provenance).expect("json") + "\n",
+            )
+            .map_err(io_error(&path))?;
+            eprintln!(
+                "wrote {} and {} in {seconds:.1} s",
+                table.display(),
+                path.display()
+            );
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,116 @@
+//! Importance functions ("densities") and their bounds over tiles.
+//!
+//! The engine asks a density two things about a tile: a conservative upper
+//! bound (to decide how deep to subdivide: a small bright region must never
+//! be skipped) and an average (to threshold the tile's code). Values are
+//! relative: only ratios matter, and the engine scales by the requested count.
+
+pub mod sphere;
+
+/// The geometry a density sees of a tile.
+///
+/// # Example
+/// ```
+/// use tessera::density::Region;
+/// fn point_type<R: Region>() -> &'static str { std::any::type_name::<R::Point>() }
+/// assert!(point_type::<tessera::tiling::sphere::SphereRegion>().contains("DVec3"));
+/// ```
+pub trait Region {
+    /// Points of the domain.
+    type Point: Copy;
+}
+
+impl Region for crate::tiling::sphere::SphereRegion {
+    type Point = glam::DVec3;
+}
+
+/// A non-negative importance function over a domain.
+///
+/// # Example
+/// ```
+/// use tessera::density::{Density, Uniform};
+/// use tessera::tiling::sphere::SphereRegion;
+/// let d: &dyn Density<SphereRegion> = &Uniform;
+/// assert_eq!(d.mean(), 1.0);
+/// ```
+pub trait Density<R: Region>: Sync {
+    /// An upper bound of the density over the region (never below the truth).
+    fn bound(&self, region: &R) -> f64;
+    /// The density's average over the region (may be approximate).
+    fn average(&self, region: &R) -> f64;
+    /// The density at a point (used for pdfs).
+    fn value(&self, point: R::Point) -> f64;
+    /// The average over the whole domain (its integral over the domain's
+    /// measure), used to turn a sample count into a magnitude.
+    fn mean(&self) -> f64;
+    /// `Some(c)` when the density is the constant `c` (lets the engine skip
+    /// every bound and average).
+    fn constant(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// The constant density 1.
+///
+/// # Example
+/// ```
+/// use tessera::density::{Density, Uniform};
+/// use tessera::tiling::sphere::SphereRegion;
+/// assert_eq!(Density::<SphereRegion>::constant(&Uniform), Some(1.0));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Uniform;
+
+impl<R: Region> Density<R> for Uniform {
+    fn bound(&self, _: &R) -> f64 {
+        1.0
+    }
+    fn average(&self, _: &R) -> f64 {
+        1.0
+    }
+    fn value(&self, _: R::Point) -> f64 {
+        1.0
+    }
+    fn mean(&self) -> f64 {
+        1.0
+    }
+    fn constant(&self) -> Option<f64> {
+        Some(1.0)
+    }
+}
+
+impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
+    fn bound(&self, region: &R) -> f64 {
+        (**self).bound(region)
+    }
+    fn average(&self, region: &R) -> f64 {
+        (**self).average(region)
+    }
+    fn value(&self, point: R::Point) -> f64 {
+        (**self).value(point)
+    }
+    fn mean(&self) -> f64 {
+        (**self).mean()
+    }
+    fn constant(&self) -> Option<f64> {
+        (**self).constant()
+    }
+}
+
+impl<R: Region, D: Density<R> + ?Sized + Send> Density<R> for Box<D> {
+    fn bound(&self, region: &R) -> f64 {
+        (**self).bound(region)
+    }
+    fn average(&self, region: &R) -> f64 {
+        (**self).average(region)
+    }
+    fn value(&self, point: R::Point) -> f64 {
+        (**self).value(point)
+    }
+    fn mean(&self) -> f64 {
+        (**self).mean()
+    }
+    fn constant(&self) -> Option<f64> {
+        (**self).constant()
+    }
+}

@@ -1,0 +1,299 @@
+//! Analytic densities on the unit sphere.
+
+use super::{Density, Uniform};
+use crate::healpix::FacePoint;
+use crate::tiling::sphere::SphereRegion;
+use crate::Error;
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// Geodesic angle between two unit vectors, stable for tiny and near-pi angles.
+///
+/// # Example
+/// ```
+/// use glam::DVec3;
+/// let a = tessera::density::sphere::angle_between(DVec3::X, DVec3::Y);
+/// assert!((a - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+/// ```
+pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// Unit vector of a longitude and latitude in degrees (Z up).
+///
+/// # Example
+/// ```
+/// let v = tessera::density::sphere::lonlat_to_vec(0.0, 90.0);
+/// assert!((v.z - 1.0).abs() < 1e-15);
+/// ```
+pub fn lonlat_to_vec(lon_deg: f64, lat_deg: f64) -> DVec3 {
+    let (lon, lat) = (lon_deg.to_radians(), lat_deg.to_radians());
+    DVec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin())
+}
+
+/// Density `contrast` inside a spherical cap and 1 outside.
+///
+/// # Example
+/// ```
+/// use tessera::density::{sphere::Cap, Density};
+/// use tessera::tiling::sphere::SphereRegion;
+/// let cap = Cap::new(0.0, 90.0, 10.0, 100.0).unwrap();
+/// assert_eq!(Density::<SphereRegion>::value(&cap, glam::DVec3::Z), 100.0);
+/// assert_eq!(Density::<SphereRegion>::value(&cap, -glam::DVec3::Z), 1.0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cap {
+    center: DVec3,
+    radius: f64,
+    contrast: f64,
+}
+
+impl Cap {
+    /// A cap centred at (`lon`, `lat`) degrees with angular radius
+    /// `radius_deg` degrees, where the density is `contrast` (>= 0) times the
+    /// density outside.
+    ///
+    /// # Example
+    /// ```
+    /// assert!(tessera::density::sphere::Cap::new(0.0, 0.0, 5.0, -1.0).is_err());
+    /// ```
+    pub fn new(lon: f64, lat: f64, radius_deg: f64, contrast: f64) -> Result<Self, Error> {
+        let spec = || format!("cap:{lon},{lat},{radius_deg},{contrast}");
+        if ![lon, lat, radius_deg, contrast]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(Error::Density(spec(), "every number must be finite".into()));
+        }
+        if !(-90.0..=90.0).contains(&lat) {
+            return Err(Error::Density(
+                spec(),
+                "latitude must be in [-90, 90]".into(),
+            ));
+        }
+        if !(0.0..=180.0).contains(&radius_deg) {
+            return Err(Error::Density(
+                spec(),
+                "radius must be in [0, 180] degrees".into(),
+            ));
+        }
+        if contrast < 0.0 {
+            return Err(Error::Density(spec(), "contrast must be >= 0".into()));
+        }
+        if contrast == 0.0 && radius_deg >= 180.0 {
+            return Err(Error::Density(
+                spec(),
+                "the density is zero everywhere".into(),
+            ));
+        }
+        Ok(Cap {
+            center: lonlat_to_vec(lon, lat),
+            radius: radius_deg.to_radians(),
+            contrast,
+        })
+    }
+
+    /// Solid angle of the cap, computed without cancellation for tiny radii.
+    ///
+    /// # Example
+    /// ```
+    /// let cap = tessera::density::sphere::Cap::new(0.0, 0.0, 180.0, 2.0).unwrap();
+    /// assert!((cap.solid_angle() - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+    /// ```
+    pub fn solid_angle(&self) -> f64 {
+        // 2 pi (1 - cos r) = 4 pi sin^2(r/2)
+        4.0 * PI * (self.radius / 2.0).sin().powi(2)
+    }
+
+    /// Whether a unit vector lies inside the (closed) cap.
+    ///
+    /// # Example
+    /// ```
+    /// let cap = tessera::density::sphere::Cap::new(0.0, 0.0, 1.0, 2.0).unwrap();
+    /// assert!(cap.contains(glam::DVec3::X));
+    /// ```
+    pub fn contains(&self, v: DVec3) -> bool {
+        angle_between(self.center, v) <= self.radius
+    }
+
+    /// The fraction of a sample set's expected mass that lies in the cap.
+    ///
+    /// # Example
+    /// ```
+    /// let cap = tessera::density::sphere::Cap::new(0.0, 90.0, 90.0, 3.0).unwrap();
+    /// assert!((cap.mass_fraction() - 0.75).abs() < 1e-12);
+    /// ```
+    pub fn mass_fraction(&self) -> f64 {
+        let inside = self.contrast * self.solid_angle();
+        inside / (inside + 4.0 * PI - self.solid_angle())
+    }
+}
+
+impl Density<SphereRegion> for Cap {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        let distance = angle_between(self.center, region.center);
+        if distance + region.radius <= self.radius {
+            self.contrast
+        } else if distance - region.radius > self.radius {
+            1.0
+        } else {
+            self.contrast.max(1.0)
+        }
+    }
+    fn average(&self, region: &SphereRegion) -> f64 {
+        let distance = angle_between(self.center, region.center);
+        if distance + region.radius <= self.radius {
+            return self.contrast;
+        }
+        if distance - region.radius > self.radius {
+            return 1.0;
+        }
+        let probes = region.probes();
+        probes.iter().map(|&p| self.value(p)).sum::<f64>() / probes.len() as f64
+    }
+    fn value(&self, point: DVec3) -> f64 {
+        if self.contains(point) {
+            self.contrast
+        } else {
+            1.0
+        }
+    }
+    fn mean(&self) -> f64 {
+        let a = self.solid_angle();
+        (self.contrast * a + (4.0 * PI - a)) / (4.0 * PI)
+    }
+}
+
+/// A density given by a closure of the direction, with a Lipschitz constant
+/// (per radian) that makes its tile bounds conservative:
+/// `bound = f(centre) + lipschitz * radius`.
+///
+/// # Example
+/// ```
+/// use tessera::density::{sphere::SphereFn, Density};
+/// use tessera::tiling::sphere::SphereRegion;
+/// // brighter towards +Z; |grad| <= 1 per radian
+/// let d = SphereFn::new(|v: glam::DVec3| 1.0 + v.z, 1.0).unwrap();
+/// assert!((Density::<SphereRegion>::mean(&d) - 1.0).abs() < 1e-3);
+/// ```
+pub struct SphereFn<F> {
+    f: F,
+    lipschitz: f64,
+    mean: f64,
+}
+
+impl<F: Fn(DVec3) -> f64 + Sync> SphereFn<F> {
+    /// Wraps `f` (negative and non-finite values count as 0). The mean is
+    /// estimated by the equal-area quadrature of HEALPix cell centres at
+    /// Nside 64; use [`SphereFn::with_mean`] when it is known exactly.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::sphere::SphereFn;
+    /// assert!(SphereFn::new(|_| 0.0, 0.0).is_err());
+    /// ```
+    pub fn new(f: F, lipschitz: f64) -> Result<Self, Error> {
+        if !(lipschitz.is_finite() && lipschitz >= 0.0) {
+            return Err(Error::Density(
+                "closure".into(),
+                format!("Lipschitz constant {lipschitz} must be finite and >= 0"),
+            ));
+        }
+        let nside = 64;
+        let mut sum = 0.0;
+        for face in 0..12u8 {
+            for j in 0..nside {
+                for i in 0..nside {
+                    let (x, y) = (
+                        (i as f64 + 0.5) / nside as f64,
+                        (j as f64 + 0.5) / nside as f64,
+                    );
+                    sum += clean(f(FacePoint::new(face, x, y).to_vec()));
+                }
+            }
+        }
+        let mean = sum / (12 * nside * nside) as f64;
+        if mean.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !mean.is_finite() {
+            return Err(Error::Density(
+                "closure".into(),
+                format!("its mean over the sphere is {mean}; it must be positive and finite"),
+            ));
+        }
+        Ok(SphereFn { f, lipschitz, mean })
+    }
+
+    /// Replaces the estimated mean (integral / 4 pi) by an exact value.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{sphere::SphereFn, Density};
+    /// use tessera::tiling::sphere::SphereRegion;
+    /// let d = SphereFn::new(|v: glam::DVec3| 1.0 + v.z, 1.0).unwrap().with_mean(1.0);
+    /// assert_eq!(Density::<SphereRegion>::mean(&d), 1.0);
+    /// ```
+    pub fn with_mean(mut self, mean: f64) -> Self {
+        self.mean = mean;
+        self
+    }
+}
+
+/// Negative and non-finite importance counts as zero.
+fn clean(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 {
+        v
+    } else {
+        0.0
+    }
+}
+
+impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        clean((self.f)(region.center)) + self.lipschitz * region.radius
+    }
+    fn average(&self, region: &SphereRegion) -> f64 {
+        let probes = region.probes();
+        probes.iter().map(|&p| clean((self.f)(p))).sum::<f64>() / probes.len() as f64
+    }
+    fn value(&self, point: DVec3) -> f64 {
+        clean((self.f)(point))
+    }
+    fn mean(&self) -> f64 {
+        self.mean
+    }
+}
+
+/// Parses a command-line density: `uniform` or `cap:LON,LAT,RADIUS_DEG,CONTRAST`.
+///
+/// # Example
+/// ```
+/// use tessera::density::sphere::parse;
+/// assert!(parse("uniform").is_ok());
+/// assert!(parse("cap:10,20,5,100").is_ok());
+/// let err = parse("cap:1,2").err().unwrap().to_string();
+/// assert!(err.contains("cap:1,2"));
+/// ```
+pub fn parse(spec: &str) -> Result<Box<dyn Density<SphereRegion> + Send>, Error> {
+    let fail = |why: &str| Error::Density(spec.to_string(), why.to_string());
+    if spec == "uniform" {
+        return Ok(Box::new(Uniform));
+    }
+    if let Some(args) = spec.strip_prefix("cap:") {
+        let numbers: Vec<f64> = args
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| fail("expected numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))?;
+        let [lon, lat, radius, contrast] = numbers[..] else {
+            return Err(fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"));
+        };
+        return Cap::new(lon, lat, radius, contrast)
+            .map(|c| Box::new(c) as Box<dyn Density<SphereRegion> + Send>)
+            .map_err(|e| match e {
+                Error::Density(_, why) => fail(&why),
+                other => other,
+            });
+    }
+    Err(fail(
+        "unknown density; expected 'uniform' or 'cap:LON,LAT,RADIUS_DEG,CONTRAST'",
+    ))
+}

@@ -1,0 +1,198 @@
+//! The adaptive recursion shared by every tile system.
+//!
+//! ```text
+//! visit(tile):
+//!     if capacity(level) >= magnitude * bound(tile):      terminal
+//!         d = magnitude * average(tile)
+//!         if code(tile) < d: emit(sample(tile, d / capacity(level)), rank = code / d)
+//!     else: visit every child
+//! ```
+//! `magnitude` is the sample count the whole domain would receive at density
+//! 1. Ranks order the output progressively: the samples with rank below `s`
+//! are those a `s`-times smaller request accepts, so every prefix of the
+//! output is itself a well-spread set. The roots are visited in parallel and
+//! gathered in order, so the output does not depend on the thread count.
+
+use crate::density::{Density, Region};
+use crate::tiling::TileSystem;
+use crate::Error;
+use rayon::prelude::*;
+
+/// A generated sample.
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
+/// let samples = engine::generate(&SphereTiling::default(), &Uniform, 10, true).unwrap();
+/// assert_eq!(samples.len(), 10);
+/// assert!(samples.windows(2).all(|w| w[0].rank <= w[1].rank));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample<P> {
+    /// Where the sample is.
+    pub position: P,
+    /// Progressive rank in `[0, 1)`: smaller ranks survive smaller requests.
+    pub rank: f64,
+}
+
+/// Every sample the tiling accepts at the given magnitude, in root order
+/// (not yet ranked).
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
+/// let all = engine::collect(&SphereTiling::default(), &Uniform, 960.0);
+/// assert_eq!(all.len(), 960);
+/// ```
+pub fn collect<S, D>(system: &S, density: &D, magnitude: f64) -> Vec<Sample<S::Point>>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    let walker = Walker {
+        system,
+        density,
+        magnitude,
+        constant: density.constant(),
+    };
+    let roots = system.roots();
+    let parts: Vec<Vec<Sample<S::Point>>> = roots
+        .par_iter()
+        .map(|root| {
+            let mut out = Vec::new();
+            walker.visit(root, &mut out);
+            out
+        })
+        .collect();
+    parts.concat()
+}
+
+struct Walker<'a, S, D: ?Sized> {
+    system: &'a S,
+    density: &'a D,
+    magnitude: f64,
+    constant: Option<f64>,
+}
+
+impl<S, D> Walker<'_, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    fn visit(&self, tile: &S::Tile, out: &mut Vec<Sample<S::Point>>) {
+        let level = self.system.level(tile);
+        let capacity = self.system.capacity(level);
+        let (bound, region) = match self.constant {
+            Some(c) => (c, None),
+            None => {
+                let region = self.system.region(tile);
+                (self.density.bound(&region), Some(region))
+            }
+        };
+        let bound = self.magnitude * bound;
+        if !(bound > 0.0) {
+            return; // nothing to place here (zero density)
+        }
+        if capacity >= bound || level >= self.system.max_level() {
+            let d = match (self.constant, &region) {
+                (Some(c), _) => self.magnitude * c,
+                (None, Some(r)) => self.magnitude * self.density.average(r),
+                (None, None) => unreachable!("a region exists whenever the density varies"),
+            };
+            let code = self.system.code(tile) as f64;
+            if code < d {
+                out.push(Sample {
+                    position: self.system.sample(tile, (d / capacity).min(1.0)),
+                    rank: code / d,
+                });
+            }
+            return;
+        }
+        for i in 0..self.system.child_count(tile) {
+            self.visit(&self.system.child(tile, i), out);
+        }
+    }
+}
+
+/// Generates about `count` samples (exactly `count` when `exact`) following
+/// `density`, in progressive order.
+///
+/// Exactness: the magnitude is first set so that the expected count is
+/// `count`; if fewer samples come out it is raised and the recursion re-run,
+/// then the `count` samples of smallest rank are kept, which is a
+/// progressive prefix, never a spatially truncated set.
+///
+/// # Example
+/// ```
+/// use tessera::{density::sphere::Cap, engine, tiling::sphere::SphereTiling};
+/// let cap = Cap::new(0.0, 90.0, 20.0, 50.0).unwrap();
+/// let s = engine::generate(&SphereTiling::default(), &cap, 1000, true).unwrap();
+/// assert_eq!(s.len(), 1000);
+/// ```
+pub fn generate<S, D>(
+    system: &S,
+    density: &D,
+    count: usize,
+    exact: bool,
+) -> Result<Vec<Sample<S::Point>>, Error>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    let mean = density.mean();
+    if !(mean.is_finite() && mean > 0.0) {
+        return Err(Error::Request(format!(
+            "the density's mean over the domain is {mean}; it must be positive and finite"
+        )));
+    }
+    let mut magnitude = count as f64 / mean;
+    let mut samples = collect(system, density, magnitude);
+    for _ in 0..16 {
+        if !exact || samples.len() >= count {
+            break;
+        }
+        let ratio = count as f64 / samples.len().max(1) as f64;
+        magnitude *= (ratio * 1.01).clamp(1.001, 4.0);
+        samples = collect(system, density, magnitude);
+    }
+    if exact && samples.len() < count {
+        return Err(Error::Request(format!(
+            "only {} samples fit at the deepest level; {count} were requested",
+            samples.len()
+        )));
+    }
+    order_by_rank(&mut samples);
+    if exact {
+        samples.truncate(count);
+    }
+    Ok(samples)
+}
+
+/// Sorts samples progressively (stable, so ties keep their deterministic
+/// root order).
+fn order_by_rank<P: Send>(samples: &mut [Sample<P>]) {
+    samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
+}
+
+/// The pdf (per unit measure of the domain) the samples follow at a point.
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
+/// let p = engine::pdf(&SphereTiling::default(), &Uniform, glam::DVec3::Z);
+/// assert!((p - 1.0 / (4.0 * std::f64::consts::PI)).abs() < 1e-15);
+/// ```
+pub fn pdf<S, D>(system: &S, density: &D, point: S::Point) -> f64
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    density.value(point) / (density.mean() * system.measure())
+}

@@ -1,0 +1,217 @@
+//! Writing and reading point sets.
+//!
+//! Text: one point per line, coordinates separated by spaces (UTK text).
+//! Binary (UTK): a 20-byte header — magic `0x214B5455` (little-endian),
+//! type byte 5 (f64) and three zero bytes, `u32` number of sets (1), `u32`
+//! point count, `u32` dimensions — then little-endian f64 values.
+
+use crate::Error;
+use glam::DVec3;
+use std::io::{BufRead, Read, Write};
+use std::path::Path;
+
+/// Magic number opening a UTK binary point file.
+pub const UTK_MAGIC: u32 = 0x214B_5455;
+const UTK_F64: u8 = 5;
+
+/// How sphere samples are written.
+///
+/// # Example
+/// ```
+/// use tessera::io::points::SphereFormat;
+/// assert_eq!("lonlat".parse::<SphereFormat>().unwrap(), SphereFormat::LonLat);
+/// assert!("nope".parse::<SphereFormat>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SphereFormat {
+    /// `x y z` unit vectors, Z up.
+    Xyz,
+    /// `lon lat` in degrees, lon in [-180, 180), lat in [-90, 90].
+    LonLat,
+    /// CSV with a header `x,y,z,lon,lat,pdf`.
+    Csv,
+    /// UTK binary, 3 dimensions.
+    Bin,
+}
+
+impl std::str::FromStr for SphereFormat {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        match s {
+            "xyz" | "txt" => Ok(SphereFormat::Xyz),
+            "lonlat" => Ok(SphereFormat::LonLat),
+            "csv" => Ok(SphereFormat::Csv),
+            "bin" => Ok(SphereFormat::Bin),
+            other => Err(Error::Request(format!(
+                "unknown format '{other}'; expected xyz, lonlat, csv or bin"
+            ))),
+        }
+    }
+}
+
+/// Writes the UTK binary header for `points` points of `dims` dimensions.
+///
+/// # Example
+/// ```
+/// let mut out = Vec::new();
+/// tessera::io::points::write_utk_header(&mut out, 4, 3).unwrap();
+/// assert_eq!(out.len(), 20);
+/// assert_eq!(&out[..4], &0x214B5455u32.to_le_bytes());
+/// ```
+pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std::io::Result<()> {
+    let count = u32::try_from(points)
+        .map_err(|_| std::io::Error::other("UTK binary holds at most 2^32-1 points"))?;
+    out.write_all(&UTK_MAGIC.to_le_bytes())?;
+    out.write_all(&[UTK_F64, 0, 0, 0])?;
+    out.write_all(&1u32.to_le_bytes())?;
+    out.write_all(&count.to_le_bytes())?;
+    out.write_all(&(dims as u32).to_le_bytes())
+}
+
+/// Writes sphere points in the given format; `pdf` is asked only for CSV.
+///
+/// # Example
+/// ```
+/// use tessera::io::points::{write_sphere, SphereFormat};
+/// let mut out = Vec::new();
+/// write_sphere(&mut out, &[glam::DVec3::Z], SphereFormat::LonLat, |_| 0.0).unwrap();
+/// assert_eq!(String::from_utf8(out).unwrap(), "0 90\n");
+/// ```
+pub fn write_sphere(
+    out: &mut impl Write,
+    points: &[DVec3],
+    format: SphereFormat,
+    pdf: impl Fn(DVec3) -> f64,
+) -> std::io::Result<()> {
+    match format {
+        SphereFormat::Xyz => {
+            for p in points {
+                writeln!(out, "{} {} {}", p.x, p.y, p.z)?;
+            }
+        }
+        SphereFormat::LonLat => {
+            for &p in points {
+                let (lon, lat) = crate::healpix::lonlat_deg(p);
+                writeln!(out, "{lon} {lat}")?;
+            }
+        }
+        SphereFormat::Csv => {
+            writeln!(out, "x,y,z,lon,lat,pdf")?;
+            for &p in points {
+                let (lon, lat) = crate::healpix::lonlat_deg(p);
+                writeln!(out, "{},{},{},{lon},{lat},{}", p.x, p.y, p.z, pdf(p))?;
+            }
+        }
+        SphereFormat::Bin => {
+            write_utk_header(out, points.len(), 3)?;
+            let mut buffer = Vec::with_capacity(points.len().min(1 << 16) * 24);
+            for chunk in points.chunks(1 << 16) {
+                buffer.clear();
+                for p in chunk {
+                    for v in [p.x, p.y, p.z] {
+                        buffer.extend_from_slice(&v.to_le_bytes());
+                    }
+                }
+                out.write_all(&buffer)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads a point set written by tessera: UTK binary (detected by its magic)
+/// or text with `dims` numbers per line (blank lines and `#` comments
+/// skipped; a CSV header line is skipped and commas separate values).
+///
+/// # Example
+/// ```
+/// let pts = tessera::io::points::read_points_from(&b"1 0 0\n0 1 0\n"[..], 3, "mem").unwrap();
+/// assert_eq!(pts, vec![vec![1.0, 0.0, 0.0], vec![0.0, 1.0, 0.0]]);
+/// ```
+pub fn read_points_from(
+    mut input: impl Read,
+    dims: usize,
+    name: &str,
+) -> Result<Vec<Vec<f64>>, Error> {
+    let fail = |reason: String| Error::File {
+        path: name.into(),
+        reason,
+    };
+    let mut bytes = Vec::new();
+    input
+        .read_to_end(&mut bytes)
+        .map_err(|e| fail(format!("cannot read: {e}")))?;
+    if bytes.len() >= 4 && bytes[..4] == UTK_MAGIC.to_le_bytes() {
+        if bytes.len() < 20 || bytes[4] != UTK_F64 {
+            return Err(fail("UTK binary header is truncated or not f64".into()));
+        }
+        let word = |at: usize| {
+            u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as usize
+        };
+        let (count, file_dims) = (word(12), word(16));
+        if file_dims != dims {
+            return Err(fail(format!(
+                "holds {file_dims}-dimensional points, expected {dims}"
+            )));
+        }
+        let body = &bytes[20..];
+        if body.len() != count * dims * 8 {
+            return Err(fail(format!(
+                "header announces {count} points but the file holds {} bytes of data",
+                body.len()
+            )));
+        }
+        return Ok(body
+            .chunks_exact(dims * 8)
+            .map(|p| {
+                p.chunks_exact(8)
+                    .map(|b| f64::from_le_bytes(b.try_into().expect("8-byte chunk")))
+                    .collect()
+            })
+            .collect());
+    }
+    let mut points = Vec::new();
+    for (number, line) in bytes.lines().enumerate() {
+        let line = line.map_err(|e| fail(format!("line {}: {e}", number + 1)))?;
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let values: Result<Vec<f64>, _> = line
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(str::parse::<f64>)
+            .collect();
+        match values {
+            Ok(v) if v.len() >= dims => points.push(v[..dims].to_vec()),
+            Ok(v) => {
+                return Err(fail(format!(
+                    "line {}: {} values, expected {dims}",
+                    number + 1,
+                    v.len()
+                )))
+            }
+            Err(_) if points.is_empty() && number == 0 => continue, // CSV header
+            Err(_) => return Err(fail(format!("line {}: not a list of numbers", number + 1))),
+        }
+    }
+    Ok(points)
+}
+
+/// Reads a point file from disk (see [`read_points_from`]).
+///
+/// # Example
+/// ```
+/// assert!(tessera::io::points::read_points(std::path::Path::new("/no/such/file"), 3).is_err());
+/// ```
+pub fn read_points(path: &Path, dims: usize) -> Result<Vec<Vec<f64>>, Error> {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    read_points_from(
+        std::io::BufReader::new(file),
+        dims,
+        &path.display().to_string(),
+    )
+}

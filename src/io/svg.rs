@@ -1,0 +1,101 @@
+//! SVG drawings of tilings and their samples.
+
+use crate::healpix::lonlat_deg;
+use crate::tiling::sphere::{SphereTile, SphereTiling};
+use crate::tiling::TileSystem;
+use std::fmt::Write;
+
+const WIDTH: f64 = 1440.0;
+const HEIGHT: f64 = 720.0;
+
+/// Draws every tile of a sphere level in equirectangular projection
+/// (longitude -180..180 left to right, latitude 90 at the top), filled by
+/// code rank (dark = small code: kept first), outlined, and the given points
+/// as dots.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::sphere::SphereTiling;
+/// let svg = tessera::io::svg::sphere_tiles(&SphereTiling::default(), 0, &[glam::DVec3::X]);
+/// assert!(svg.starts_with("<svg") && svg.matches("<polygon").count() == 240);
+/// ```
+pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -> String {
+    let mut tiles: Vec<SphereTile> = tiling.roots();
+    for _ in 0..level {
+        tiles = tiles
+            .iter()
+            .flat_map(|t| (0..4).map(move |c| tiling.child(t, c)))
+            .collect();
+    }
+    let capacity = tiling.capacity(level);
+    let outline = tiling.shape().outline();
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}">"#
+    );
+    let _ = writeln!(
+        svg,
+        r#"<rect width="{WIDTH}" height="{HEIGHT}" fill="white"/>"#
+    );
+    let stroke = (0.8 / (1 << level) as f64).max(0.1);
+    for tile in &tiles {
+        let mut lonlats = Vec::new();
+        for k in 0..outline.len() {
+            let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
+            for s in 0..4 {
+                let t = s as f64 / 4.0;
+                let local = [
+                    a.0 as f64 + t * (b.0 - a.0) as f64,
+                    a.1 as f64 + t * (b.1 - a.1) as f64,
+                ];
+                lonlats.push(lonlat_deg(tiling.face_point(tile, local).to_vec()));
+            }
+        }
+        unwrap_longitudes(&mut lonlats);
+        let grey = 40.0 + 200.0 * tile.code as f64 / capacity;
+        let mut path = String::new();
+        for (lon, lat) in &lonlats {
+            let _ = write!(path, "{:.2},{:.2} ", x_of(*lon), y_of(*lat));
+        }
+        let _ = writeln!(
+            svg,
+            r#"<polygon points="{path}" fill="rgb({g},{g},255)" stroke="black" stroke-width="{stroke}"/>"#,
+            g = grey as u8
+        );
+    }
+    let radius = (3.0 / (1 << level) as f64).max(0.6);
+    for &p in points {
+        let (lon, lat) = lonlat_deg(p);
+        let _ = writeln!(
+            svg,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="{radius}" fill="red"/>"#,
+            x_of(lon),
+            y_of(lat)
+        );
+    }
+    svg.push_str("</svg>\n");
+    svg
+}
+
+fn x_of(lon: f64) -> f64 {
+    (lon + 180.0) / 360.0 * WIDTH
+}
+
+fn y_of(lat: f64) -> f64 {
+    (90.0 - lat) / 180.0 * HEIGHT
+}
+
+/// Makes consecutive longitudes continuous so polygons crossing the
+/// antimeridian are drawn whole (they overhang the picture's edge).
+fn unwrap_longitudes(lonlats: &mut [(f64, f64)]) {
+    for k in 1..lonlats.len() {
+        let previous = lonlats[k - 1].0;
+        while lonlats[k].0 - previous > 180.0 {
+            lonlats[k].0 -= 360.0;
+        }
+        while lonlats[k].0 - previous < -180.0 {
+            lonlats[k].0 += 360.0;
+        }
+    }
+}

@@ -1,0 +1,197 @@
+//! Table formats and the tables embedded from `luts/`.
+//!
+//! A table file is a postcard-encoded struct whose first field is its format
+//! version; `luts/*.provenance.json` beside it records the command, seed,
+//! parameters and resulting metrics. `tessera lut build` regenerates both.
+
+use crate::tiling::polyomino::{Placement, Rule};
+use crate::Error;
+use serde::{Deserialize, Serialize};
+use std::sync::{Arc, OnceLock};
+
+/// Format version written into and required from sphere tables.
+pub const SPHERE_LUT_VERSION: u32 = 1;
+
+/// Everything the sphere tile system needs at run time.
+///
+/// # Example
+/// ```
+/// let lut = tessera::lut::sphere_lut();
+/// assert_eq!(lut.version, tessera::lut::SPHERE_LUT_VERSION);
+/// assert_eq!(lut.patch.len(), 20);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphereLut {
+    /// Format version, [`SPHERE_LUT_VERSION`].
+    pub version: u32,
+    /// Seed the optimiser ran with.
+    pub seed: u64,
+    /// The two dissections of the doubled P-pentomino.
+    pub rules: Vec<Rule>,
+    /// `child_rule[rule][child]`: the rule a child subdivides with.
+    pub child_rule: Vec<[u8; 4]>,
+    /// `child_digit[rule][child]`: the child's rank among its siblings.
+    pub child_digit: Vec<[u8; 4]>,
+    /// The 20 pentominoes of a face's 10x10 patch.
+    pub patch: Vec<Placement>,
+    /// Rule of each of the 240 roots (face-major).
+    pub root_rule: Vec<u8>,
+    /// Code (rank) of each of the 240 roots.
+    pub root_rank: Vec<u32>,
+    /// Levels `0..exact_levels` index tiles by tree position.
+    pub exact_levels: u8,
+    /// Class of each child of each tile of level `exact_levels - 1`.
+    pub entry_class: Vec<[u32; 4]>,
+    /// Neighbourhood-class automaton: `transitions[class][child]`.
+    pub transitions: Vec<[u32; 4]>,
+    /// Number of importance bins per structural index.
+    pub bins: u8,
+    /// Offsets per level (the last one serves every deeper level), indexed
+    /// `index * bins + bin`, in the tile's frame (cells).
+    pub tables: Vec<Vec<[f32; 2]>>,
+}
+
+impl SphereLut {
+    /// The importance bin of a density fraction `f` in `(0, 1]` of a level's
+    /// capacity: bins are equally spaced in `log4 f` from 1/4 (bin 0) to 1.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// assert_eq!(lut.bin(1.0), lut.bins as usize - 1);
+    /// assert_eq!(lut.bin(0.25), 0);
+    /// assert_eq!(lut.bin(1e-9), 0);
+    /// ```
+    pub fn bin(&self, fraction: f64) -> usize {
+        bin_of(fraction, self.bins as usize)
+    }
+
+    /// Decodes a table, checking its version and internal consistency.
+    ///
+    /// # Example
+    /// ```
+    /// assert!(tessera::lut::SphereLut::from_bytes(b"not a table").is_err());
+    /// ```
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, Error> {
+        let version = bytes.first().copied().unwrap_or(0) as u32;
+        if version != SPHERE_LUT_VERSION {
+            return Err(Error::Table(format!(
+                "sphere table has format version {version}, this build reads version {SPHERE_LUT_VERSION}"
+            )));
+        }
+        let lut: SphereLut = postcard::from_bytes(bytes)
+            .map_err(|e| Error::Table(format!("sphere table does not decode: {e}")))?;
+        lut.validate()?;
+        Ok(lut)
+    }
+
+    /// Encodes the table.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// let bytes = lut.to_bytes();
+    /// assert_eq!(*tessera::lut::SphereLut::from_bytes(&bytes).unwrap(), *lut);
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        postcard::to_allocvec(self).expect("serialising to memory cannot fail")
+    }
+
+    /// Checks every index the run-time recursion will follow.
+    fn validate(&self) -> Result<(), Error> {
+        let bad = |what: &str| Err(Error::Table(format!("sphere table: {what}")));
+        let roots = crate::tiling::sphere::ROOT_COUNT;
+        if self.rules.len() != 2 || self.rules.iter().any(|r| r.children.len() != 4) {
+            return bad("expected two rules of four children");
+        }
+        if self.child_rule.len() != 2 || self.child_digit.len() != 2 {
+            return bad("child rule/digit tables must have two rows");
+        }
+        if self.child_rule.iter().flatten().any(|&r| r > 1) {
+            return bad("child rule out of range");
+        }
+        for digits in &self.child_digit {
+            let mut sorted = *digits;
+            sorted.sort_unstable();
+            if sorted != [0, 1, 2, 3] {
+                return bad("child digits must be a permutation of 0..4");
+            }
+        }
+        if self.patch.len() != 20 || self.root_rule.len() != roots || self.root_rank.len() != roots
+        {
+            return bad("patch or root tables have the wrong size");
+        }
+        let mut ranks = self.root_rank.clone();
+        ranks.sort_unstable();
+        if ranks.iter().enumerate().any(|(i, &r)| r as usize != i) {
+            return bad("root ranks must be a permutation of 0..240");
+        }
+        if self.exact_levels == 0 || self.bins == 0 {
+            return bad("exact_levels and bins must be positive");
+        }
+        let last_exact = roots << (2 * (self.exact_levels as usize - 1));
+        let classes = self.transitions.len();
+        if self.entry_class.len() != last_exact
+            || self
+                .entry_class
+                .iter()
+                .chain(&self.transitions)
+                .flatten()
+                .any(|&c| c as usize >= classes)
+        {
+            return bad("class automaton refers to a missing class");
+        }
+        if self.tables.len() <= self.exact_levels as usize {
+            return bad("need one table per exact level and at least one class table");
+        }
+        for (level, table) in self.tables.iter().enumerate() {
+            let rows = if level < self.exact_levels as usize {
+                roots << (2 * level)
+            } else {
+                classes
+            };
+            if table.len() != rows * self.bins as usize {
+                return bad(&format!("offset table {level} has the wrong size"));
+            }
+            if table.iter().flatten().any(|v| !v.is_finite()) {
+                return bad(&format!("offset table {level} holds a non-finite value"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Bin of a density fraction, shared by the run time and the optimiser.
+pub(crate) fn bin_of(fraction: f64, bins: usize) -> usize {
+    let position = (1.0 + fraction.log(4.0)) * (bins - 1) as f64;
+    if position.is_nan() || position <= 0.0 {
+        0
+    } else {
+        (position.round() as usize).min(bins - 1)
+    }
+}
+
+/// The density fraction an importance bin is optimised for.
+pub(crate) fn fraction_of_bin(bin: usize, bins: usize) -> f64 {
+    4f64.powf(bin as f64 / (bins - 1).max(1) as f64 - 1.0)
+}
+
+static SPHERE_BYTES: &[u8] = include_bytes!("../luts/sphere.lut");
+
+/// The sphere table shipped in `luts/sphere.lut`, decoded once.
+///
+/// # Example
+/// ```
+/// let lut = tessera::lut::sphere_lut();
+/// assert_eq!(lut.rules.len(), 2);
+/// ```
+pub fn sphere_lut() -> Arc<SphereLut> {
+    static LUT: OnceLock<Arc<SphereLut>> = OnceLock::new();
+    LUT.get_or_init(|| {
+        Arc::new(
+            SphereLut::from_bytes(SPHERE_BYTES)
+                .expect("the embedded luts/sphere.lut is checked by the test suite"),
+        )
+    })
+    .clone()
+}

@@ -1,0 +1,166 @@
+//! Exact-cover search (Knuth's Algorithm X, fewest-options column first).
+//!
+//! Used offline to find polyomino dissections: the two 4-rep rules of the
+//! P-pentomino, the 20-tile patch of a 10x10 face, the 81-rep G-hexomino rule.
+
+use crate::tiling::polyomino::{Orientation, Placement, Shape};
+use std::collections::HashSet;
+
+/// Every placement of `shape` (any of the 8 orientations, any translation)
+/// whose cells all lie in `region`, deduplicated by the set of cells covered.
+///
+/// # Example
+/// ```
+/// use tessera::optimize::exact_cover::placements_in;
+/// use tessera::tiling::polyomino::Shape;
+/// let domino = Shape::new(vec![(0, 0), (1, 0)]);
+/// let square: Vec<(i32, i32)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
+/// // two horizontal and two vertical dominoes fit in a 2x2 square
+/// assert_eq!(placements_in(&domino, &square).len(), 4);
+/// ```
+pub fn placements_in(shape: &Shape, region: &[(i32, i32)]) -> Vec<Placement> {
+    let cells: HashSet<(i32, i32)> = region.iter().copied().collect();
+    let mut seen = HashSet::new();
+    let mut out = Vec::new();
+    for orientation in Orientation::ALL {
+        let at_origin = Placement::new((0, 0), orientation);
+        let base: Vec<(i32, i32)> = at_origin.cells(shape).collect();
+        // translate so that the first shape cell lands on every region cell
+        for &anchor in region {
+            let (dx, dy) = (anchor.0 - base[0].0, anchor.1 - base[0].1);
+            if !base.iter().all(|c| cells.contains(&(c.0 + dx, c.1 + dy))) {
+                continue;
+            }
+            let mut key: Vec<(i32, i32)> = base.iter().map(|c| (c.0 + dx, c.1 + dy)).collect();
+            key.sort_unstable();
+            if seen.insert(key) {
+                out.push(Placement::new((dx, dy), orientation));
+            }
+        }
+    }
+    out
+}
+
+/// Finds exact covers of `region` by copies of `shape`.
+///
+/// Candidates are tried in the order given by `order_seed` (0 keeps the
+/// natural order, other values shuffle deterministically), so different seeds
+/// reach different tilings first. The search stops after `limit` solutions.
+///
+/// # Example
+/// ```
+/// use tessera::optimize::exact_cover::tilings;
+/// use tessera::tiling::polyomino::Shape;
+/// let domino = Shape::new(vec![(0, 0), (1, 0)]);
+/// let square: Vec<(i32, i32)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
+/// assert_eq!(tilings(&domino, &square, usize::MAX, 0).len(), 2);
+/// ```
+pub fn tilings(
+    shape: &Shape,
+    region: &[(i32, i32)],
+    limit: usize,
+    order_seed: u64,
+) -> Vec<Vec<Placement>> {
+    let mut options = placements_in(shape, region);
+    if order_seed != 0 {
+        shuffle(&mut options, order_seed);
+    }
+    let index: std::collections::HashMap<(i32, i32), usize> =
+        region.iter().enumerate().map(|(i, &c)| (c, i)).collect();
+    let option_cells: Vec<Vec<usize>> = options
+        .iter()
+        .map(|p| p.cells(shape).map(|c| index[&c]).collect())
+        .collect();
+    let mut by_cell: Vec<Vec<usize>> = vec![Vec::new(); region.len()];
+    for (o, cells) in option_cells.iter().enumerate() {
+        for &c in cells {
+            by_cell[c].push(o);
+        }
+    }
+    let mut search = Search {
+        option_cells: &option_cells,
+        by_cell: &by_cell,
+        covered: vec![false; region.len()],
+        chosen: Vec::new(),
+        solutions: Vec::new(),
+        limit,
+    };
+    search.run();
+    search
+        .solutions
+        .into_iter()
+        .map(|s| s.into_iter().map(|o| options[o]).collect())
+        .collect()
+}
+
+struct Search<'a> {
+    option_cells: &'a [Vec<usize>],
+    by_cell: &'a [Vec<usize>],
+    covered: Vec<bool>,
+    chosen: Vec<usize>,
+    solutions: Vec<Vec<usize>>,
+    limit: usize,
+}
+
+impl Search<'_> {
+    fn fits(&self, option: usize) -> bool {
+        self.option_cells[option].iter().all(|&c| !self.covered[c])
+    }
+
+    fn run(&mut self) {
+        if self.solutions.len() >= self.limit {
+            return;
+        }
+        // the uncovered cell with the fewest fitting options
+        let mut best: Option<(usize, usize)> = None;
+        for cell in 0..self.covered.len() {
+            if self.covered[cell] {
+                continue;
+            }
+            let count = self.by_cell[cell].iter().filter(|&&o| self.fits(o)).count();
+            if best.is_none_or(|(_, n)| count < n) {
+                best = Some((cell, count));
+                if count <= 1 {
+                    break;
+                }
+            }
+        }
+        let Some((cell, count)) = best else {
+            self.solutions.push(self.chosen.clone());
+            return;
+        };
+        if count == 0 {
+            return;
+        }
+        for &option in &self.by_cell[cell] {
+            if !self.fits(option) {
+                continue;
+            }
+            for &c in &self.option_cells[option] {
+                self.covered[c] = true;
+            }
+            self.chosen.push(option);
+            self.run();
+            self.chosen.pop();
+            for &c in &self.option_cells[option] {
+                self.covered[c] = false;
+            }
+            if self.solutions.len() >= self.limit {
+                return;
+            }
+        }
+    }
+}
+
+/// Deterministic Fisher-Yates shuffle driven by SplitMix64.
+fn shuffle<T>(items: &mut [T], seed: u64) {
+    let mut state = seed;
+    for i in (1..items.len()).rev() {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        items.swap(i, (z % (i as u64 + 1)) as usize);
+    }
+}

@@ -1,0 +1,6 @@
+//! Offline optimisation: tiling searches, rankings and Lloyd relaxation that
+//! produce the tables in `luts/`. Nothing here runs when sampling.
+
+pub mod exact_cover;
+pub mod ranking;
+pub mod sphere;

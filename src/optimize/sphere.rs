@@ -1,0 +1,1063 @@
+//! Offline construction of the sphere table (`tessera lut build --system sphere`).
+//!
+//! Stages, each deterministic for a seed:
+//! 1. the two 4-rep dissections of the P-pentomino (exact cover);
+//! 2. the 20-pentomino patch of a 10x10 face: the best of many seeded random
+//!    exact covers, scored by how evenly the tiles' centroids spread;
+//! 3. which rule each child uses and each child's rank among its siblings,
+//!    scored on the subdivided periodic patch (centroids, and the subsets kept
+//!    by thresholds: void-and-cluster in spirit);
+//! 4. root ranks by farthest-point ordering of the 240 roots on the sphere;
+//! 5. structural classes: neighbourhood signatures of every tile at the
+//!    class levels, seen across seams and three-face corners, and the
+//!    automaton between them;
+//! 6. offsets: Lloyd relaxation on the sphere itself (HEALPix cells as an
+//!    equal-area quadrature), per level and importance bin, with each
+//!    structural index sharing one offset.
+
+use super::exact_cover;
+use super::ranking::farthest_point_ranks;
+use crate::healpix::{self, Cell, Dir, FacePoint};
+use crate::lut::{fraction_of_bin, SphereLut, SPHERE_LUT_VERSION};
+use crate::tiling::polyomino::{Orientation, Placement, Rule, Shape};
+use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
+use crate::tiling::TileSystem;
+use crate::Error;
+use glam::DVec3;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Parameters of a sphere table build.
+///
+/// # Example
+/// ```
+/// let options = tessera::optimize::sphere::BuildOptions::default();
+/// assert!(options.table_levels >= 5);
+/// ```
+#[derive(Clone, Debug, Serialize)]
+pub struct BuildOptions {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Random 10x10 patches tried.
+    pub patch_candidates: usize,
+    /// Levels indexed by tree position (one structural index per tile).
+    pub exact_levels: u8,
+    /// Deepest level whose neighbourhoods are enumerated for the automaton.
+    pub class_depth: u8,
+    /// Neighbourhood radius (cells) of a structural class.
+    pub class_radius: u32,
+    /// Number of offset tables; the last serves every deeper level.
+    pub table_levels: u8,
+    /// Importance bins per structural index.
+    pub bins: u8,
+    /// Lloyd iterations per level and bin.
+    pub iterations: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            seed: 1,
+            patch_candidates: 400,
+            exact_levels: 3,
+            class_depth: 6,
+            class_radius: 2,
+            table_levels: 6,
+            bins: 8,
+            iterations: 8,
+        }
+    }
+}
+
+/// What a build measured along the way.
+///
+/// # Example
+/// ```
+/// let report = tessera::optimize::sphere::BuildReport::default();
+/// assert_eq!(report.classes, 0);
+/// ```
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct BuildReport {
+    /// Score of the chosen 10x10 patch (normalised centroid spacing).
+    pub patch_score: f64,
+    /// Score of the chosen child rules and ranks.
+    pub rule_score: f64,
+    /// Number of neighbourhood classes.
+    pub classes: usize,
+    /// New classes found at each enumerated level (closure shows as zeros).
+    pub new_classes_per_level: Vec<usize>,
+    /// Classes first met while closing the automaton below the deepest level.
+    pub classes_found_by_closure: usize,
+    /// Transitions that disagreed with the majority (inconsistent automaton).
+    pub transition_conflicts: usize,
+    /// Transitions never observed (filled with a fallback).
+    pub missing_transitions: usize,
+    /// Mean squared displacement of the last Lloyd iteration per table level.
+    pub lloyd_residual: Vec<f64>,
+    /// Wall time of each stage, seconds.
+    pub stage_seconds: Vec<(String, f64)>,
+}
+
+/// Progress callback: stage name, work done, work total.
+pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+
+/// Runs every stage and returns the table and what was measured.
+///
+/// # Example
+/// ```no_run
+/// use tessera::optimize::sphere::{build, BuildOptions};
+/// let (lut, report) = build(&BuildOptions::default(), &|_, _, _| {}).unwrap();
+/// assert_eq!(lut.patch.len(), 20);
+/// # let _ = report;
+/// ```
+pub fn build(
+    options: &BuildOptions,
+    progress: Progress,
+) -> Result<(SphereLut, BuildReport), Error> {
+    if options.exact_levels == 0
+        || options.table_levels <= options.exact_levels
+        || options.class_depth < options.exact_levels + 1
+        || options.bins < 2
+        || options.class_depth > 10
+    {
+        return Err(Error::Request(format!(
+            "inconsistent build options: {options:?} (need 0 < exact_levels < table_levels, \
+             exact_levels < class_depth <= 10, bins >= 2)"
+        )));
+    }
+    let mut report = BuildReport::default();
+    let mut clock = std::time::Instant::now();
+    let mut lap = |report: &mut BuildReport, name: &str| {
+        report
+            .stage_seconds
+            .push((name.to_string(), clock.elapsed().as_secs_f64()));
+        clock = std::time::Instant::now();
+    };
+
+    progress("dissections", 0, 1);
+    let shape = Shape::p_pentomino();
+    let rules = Rule::p_pentomino_rules();
+    if rules.len() != 2 || !rules.iter().all(|r| r.tiles_parent(&shape)) {
+        return Err(Error::Table(format!(
+            "the P-pentomino search found {} dissections, expected 2",
+            rules.len()
+        )));
+    }
+    lap(&mut report, "dissections");
+
+    let (patch, patch_score) = choose_patch(&shape, options, progress);
+    report.patch_score = patch_score;
+    lap(&mut report, "patch");
+
+    let design = choose_rules(&shape, &rules, &patch, progress);
+    report.rule_score = design.score;
+    lap(&mut report, "rules and ranks");
+
+    let mut lut = SphereLut {
+        version: SPHERE_LUT_VERSION,
+        seed: options.seed,
+        rules,
+        child_rule: design.child_rule.to_vec(),
+        child_digit: design.child_digit.to_vec(),
+        patch,
+        root_rule: (0..ROOT_COUNT)
+            .map(|r| design.root_rule[r % ROOTS_PER_FACE])
+            .collect(),
+        root_rank: Vec::new(),
+        // provisional: tree-position indices at every level we enumerate
+        exact_levels: 12,
+        entry_class: Vec::new(),
+        transitions: Vec::new(),
+        bins: options.bins,
+        tables: Vec::new(),
+    };
+    lut.root_rank = root_ranks(&lut);
+    let enumerator = SphereTiling::new(Arc::new(lut.clone()));
+    lap(&mut report, "root ranks");
+
+    let classes = classify(&enumerator, options, progress, &mut report);
+    lut.exact_levels = options.exact_levels;
+    lut.entry_class = classes.entry;
+    lut.transitions = classes.transitions;
+    report.classes = lut.transitions.len();
+    lap(&mut report, "classes");
+
+    lut.tables = relax(
+        &enumerator,
+        &lut,
+        &classes.per_level,
+        options,
+        progress,
+        &mut report,
+    );
+    lap(&mut report, "lloyd");
+    Ok((lut, report))
+}
+
+// ---------------------------------------------------------------- patch ----
+
+fn choose_patch(
+    shape: &Shape,
+    options: &BuildOptions,
+    progress: Progress,
+) -> (Vec<Placement>, f64) {
+    let region: Vec<(i32, i32)> = (0..PATCH_SIDE)
+        .flat_map(|y| (0..PATCH_SIDE).map(move |x| (x, y)))
+        .collect();
+    let total = options.patch_candidates.max(1);
+    let scored: Vec<(f64, Vec<Placement>)> = (0..total)
+        .into_par_iter()
+        .filter_map(|candidate| {
+            let seed = options
+                .seed
+                .wrapping_mul(0x9E37_79B9)
+                .wrapping_add(candidate as u64 + 1);
+            let tiling = exact_cover::tilings(shape, &region, 1, seed).pop()?;
+            let centroids: Vec<[f64; 2]> = tiling
+                .iter()
+                .map(|p| p.to_lattice(shape.centroid()))
+                .collect();
+            Some((spread_score(&centroids, PATCH_SIDE as f64), tiling))
+        })
+        .collect();
+    progress("patch", total as u64, total as u64);
+    // best score; ties to the earliest candidate keep the choice deterministic
+    let (score, patch) = scored
+        .into_iter()
+        .fold((f64::NEG_INFINITY, Vec::new()), |best, c| {
+            if c.0 > best.0 {
+                c
+            } else {
+                best
+            }
+        });
+    (patch, score)
+}
+
+/// Normalised spacing of points on a periodic square of side `period`:
+/// min + half the mean nearest-neighbour distance, in units of the
+/// hexagonal-packing spacing. Higher is better.
+fn spread_score(points: &[[f64; 2]], period: f64) -> f64 {
+    let n = points.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let mut min = f64::INFINITY;
+    let mut sum = 0.0;
+    for (i, a) in points.iter().enumerate() {
+        let mut nearest = f64::INFINITY;
+        for (j, b) in points.iter().enumerate() {
+            if i == j {
+                continue;
+            }
+            let mut dx = (a[0] - b[0]).abs() % period;
+            let mut dy = (a[1] - b[1]).abs() % period;
+            dx = dx.min(period - dx);
+            dy = dy.min(period - dy);
+            nearest = nearest.min(dx * dx + dy * dy);
+        }
+        min = min.min(nearest);
+        sum += nearest.sqrt();
+    }
+    let unit = (2.0 / (3f64.sqrt() * n as f64)).sqrt() * period;
+    (min.sqrt() + 0.5 * sum / n as f64) / unit
+}
+
+// ---------------------------------------------------------------- rules ----
+
+struct RuleDesign {
+    child_rule: [[u8; 4]; 2],
+    child_digit: [[u8; 4]; 2],
+    root_rule: [u8; ROOTS_PER_FACE],
+    score: f64,
+}
+
+/// A tile of the periodic patch used to score designs.
+#[derive(Clone, Copy)]
+struct PatchTile {
+    placement: Placement,
+    rule: u8,
+    code: u64,
+}
+
+fn patch_tiles(
+    shape: &Shape,
+    rules: &[Rule],
+    patch: &[Placement],
+    design: &RuleDesign,
+    root_codes: &[u64],
+    level: u32,
+) -> Vec<([f64; 2], u64)> {
+    let mut tiles: Vec<PatchTile> = patch
+        .iter()
+        .enumerate()
+        .map(|(i, &placement)| PatchTile {
+            placement,
+            rule: design.root_rule[i],
+            code: root_codes[i],
+        })
+        .collect();
+    for l in 0..level {
+        let weight = (ROOTS_PER_FACE as u64) << (2 * l);
+        tiles = tiles
+            .iter()
+            .flat_map(|t| {
+                let r = t.rule as usize;
+                (0..4).map(move |c| PatchTile {
+                    placement: t.placement.child(&rules[r].children[c], 2),
+                    rule: design.child_rule[r][c],
+                    code: t.code + design.child_digit[r][c] as u64 * weight,
+                })
+            })
+            .collect();
+    }
+    let period = (PATCH_SIDE << level) as f64;
+    tiles
+        .iter()
+        .map(|t| {
+            let c = t.placement.to_lattice(shape.centroid());
+            ([c[0].rem_euclid(period), c[1].rem_euclid(period)], t.code)
+        })
+        .collect()
+}
+
+fn choose_rules(
+    shape: &Shape,
+    rules: &[Rule],
+    patch: &[Placement],
+    progress: Progress,
+) -> RuleDesign {
+    let root_patterns: [[u8; ROOTS_PER_FACE]; 3] = [
+        [0; ROOTS_PER_FACE],
+        [1; ROOTS_PER_FACE],
+        std::array::from_fn(|i| (i % 2) as u8),
+    ];
+    let patch_centroids: Vec<[f64; 2]> = patch
+        .iter()
+        .map(|p| p.to_lattice(shape.centroid()))
+        .collect();
+    let order = farthest_point_ranks(patch.len(), |a, b| {
+        torus_distance(patch_centroids[a], patch_centroids[b], PATCH_SIDE as f64)
+    });
+    let root_codes: Vec<u64> = order.iter().map(|&r| r as u64).collect();
+    let identity_digits = [[0, 1, 2, 3], [0, 1, 2, 3]];
+    let level = 3;
+    let period = (PATCH_SIDE << level) as f64;
+
+    // child rules and root rules: spacing of the subdivided centroids
+    let candidates: Vec<(usize, u8)> = (0..3)
+        .flat_map(|p| (0..=255u8).map(move |m| (p, m)))
+        .collect();
+    let total = candidates.len() as u64 + 576;
+    let best_rules = candidates
+        .par_iter()
+        .map(|&(pattern, mask)| {
+            let design = RuleDesign {
+                child_rule: std::array::from_fn(|r| {
+                    std::array::from_fn(|c| (mask >> (4 * r + c)) & 1)
+                }),
+                child_digit: identity_digits,
+                root_rule: root_patterns[pattern],
+                score: 0.0,
+            };
+            let points: Vec<[f64; 2]> =
+                patch_tiles(shape, rules, patch, &design, &root_codes, level)
+                    .into_iter()
+                    .map(|(p, _)| p)
+                    .collect();
+            (spread_score(&points, period), pattern, mask)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold(
+            (f64::NEG_INFINITY, 0, 0),
+            |b, c| if c.0 > b.0 { c } else { b },
+        );
+    progress("rules", candidates.len() as u64, total);
+    let child_rule: [[u8; 4]; 2] =
+        std::array::from_fn(|r| std::array::from_fn(|c| (best_rules.2 >> (4 * r + c)) & 1));
+    let root_rule = root_patterns[best_rules.1];
+
+    // sibling ranks: spacing of the subsets kept at several thresholds
+    let perms = permutations4();
+    let pairs: Vec<(usize, usize)> = (0..24).flat_map(|a| (0..24).map(move |b| (a, b))).collect();
+    let best_digits = pairs
+        .par_iter()
+        .map(|&(a, b)| {
+            let design = RuleDesign {
+                child_rule,
+                child_digit: [perms[a], perms[b]],
+                root_rule,
+                score: 0.0,
+            };
+            let tiles = patch_tiles(shape, rules, patch, &design, &root_codes, level);
+            let capacity = tiles.len() as f64;
+            let score: f64 = [0.3, 0.4, 0.55, 0.7, 0.85]
+                .iter()
+                .map(|f| {
+                    let kept: Vec<[f64; 2]> = tiles
+                        .iter()
+                        .filter(|(_, code)| (*code as f64) < f * capacity)
+                        .map(|(p, _)| *p)
+                        .collect();
+                    spread_score(&kept, period)
+                })
+                .sum::<f64>()
+                / 5.0;
+            (score, a, b)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold(
+            (f64::NEG_INFINITY, 0, 0),
+            |b, c| if c.0 > b.0 { c } else { b },
+        );
+    progress("rules", total, total);
+    RuleDesign {
+        child_rule,
+        child_digit: [perms[best_digits.1], perms[best_digits.2]],
+        root_rule,
+        score: best_digits.0,
+    }
+}
+
+fn permutations4() -> Vec<[u8; 4]> {
+    let mut out = Vec::new();
+    for a in 0..4u8 {
+        for b in 0..4u8 {
+            for c in 0..4u8 {
+                for d in 0..4u8 {
+                    let p = [a, b, c, d];
+                    if (0..4u8).all(|v| p.contains(&v)) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn torus_distance(a: [f64; 2], b: [f64; 2], period: f64) -> f64 {
+    let dx = (a[0] - b[0]).abs().rem_euclid(period);
+    let dy = (a[1] - b[1]).abs().rem_euclid(period);
+    dx.min(period - dx).hypot(dy.min(period - dy))
+}
+
+/// Farthest-point ranks of the 240 roots on the sphere.
+fn root_ranks(lut: &SphereLut) -> Vec<u32> {
+    let shape = Shape::p_pentomino();
+    let tiling = SphereTiling::new(Arc::new(SphereLut {
+        root_rank: (0..ROOT_COUNT as u32).collect(),
+        ..lut.clone()
+    }));
+    let centres: Vec<DVec3> = tiling
+        .roots()
+        .iter()
+        .map(|t| tiling.face_point(t, shape.centroid()).to_vec())
+        .collect();
+    farthest_point_ranks(centres.len(), |a, b| {
+        crate::density::sphere::angle_between(centres[a], centres[b])
+    })
+}
+
+/// All tiles of a level in tree-index order.
+pub(crate) fn tiles_at(tiling: &SphereTiling, level: u32) -> Vec<SphereTile> {
+    let mut tiles = tiling.roots();
+    for _ in 0..level {
+        tiles = tiles
+            .par_iter()
+            .flat_map_iter(|t| (0..4).map(move |c| tiling.child(t, c)))
+            .collect();
+    }
+    tiles
+}
+
+// -------------------------------------------------------------- classes ----
+
+struct Classes {
+    /// Class of each child of each tile at level `exact_levels - 1`.
+    entry: Vec<[u32; 4]>,
+    transitions: Vec<[u32; 4]>,
+    /// For each level `exact_levels..=class_depth`: the class of every tile.
+    per_level: Vec<Vec<u32>>,
+}
+
+/// Which lattice cell holds which tile, at one level.
+struct CellMap {
+    nside: i64,
+    /// `tile * 8 + cell index in the shape`, per face, row-major.
+    owner: Vec<u32>,
+}
+
+impl CellMap {
+    fn new(tiling: &SphereTiling, tiles: &[SphereTile], level: u32) -> Self {
+        let nside = SphereTiling::nside(level);
+        let mut owner = vec![u32::MAX; 12 * (nside * nside) as usize];
+        for (t, tile) in tiles.iter().enumerate() {
+            for (k, (i, j)) in tile.placement.cells(tiling.shape()).enumerate() {
+                let at = tile.face as usize * (nside * nside) as usize
+                    + (j as i64 * nside + i as i64) as usize;
+                owner[at] = t as u32 * 8 + k as u32;
+            }
+        }
+        CellMap { nside, owner }
+    }
+
+    fn get(&self, cell: Cell) -> (usize, usize) {
+        let v = self.owner[cell.face as usize * (self.nside * self.nside) as usize
+            + (cell.j * self.nside + cell.i) as usize];
+        ((v / 8) as usize, (v % 8) as usize)
+    }
+}
+
+const LOCAL_DIRS: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
+
+fn dir_of(v: (i32, i32)) -> Dir {
+    match v {
+        (1, 0) => Dir::PlusX,
+        (0, 1) => Dir::PlusY,
+        (-1, 0) => Dir::MinusX,
+        _ => Dir::MinusY,
+    }
+}
+
+fn vec_of(d: Dir) -> (i32, i32) {
+    LOCAL_DIRS[d.index() as usize]
+}
+
+/// Steps across a seam if needed; returns the new cell and the rotation
+/// taking the new face's frame to the old one.
+fn step_framed(cell: Cell, nside: i64, dir: Dir) -> (Cell, Orientation) {
+    let (next, _) = healpix::step(cell, nside, dir);
+    if next.face == cell.face {
+        return (next, Orientation::IDENTITY);
+    }
+    // the direction that leads back, in the new face's frame
+    let back = Dir::ALL
+        .into_iter()
+        .find(|&d| healpix::step(next, nside, d).0 == cell)
+        .expect("face gluing is symmetric");
+    let b = vec_of(back);
+    let forward = vec_of(dir);
+    let rotation = (0..4)
+        .map(|t| Orientation::new(t, false))
+        .find(|o| o.apply((-b.0, -b.1)) == forward)
+        .expect("a quarter turn maps one axis direction to another");
+    (next, rotation)
+}
+
+/// Every cell within `radius` steps of a tile, found by walking the cell
+/// graph (so seams and three-face corners are seen as they are), with its
+/// centre (doubled, in the tile's own frame) and the map from its face's
+/// frame to the tile's frame.
+fn window(
+    tiling: &SphereTiling,
+    tile: &SphereTile,
+    radius: u32,
+) -> Vec<(Cell, (i32, i32), Orientation)> {
+    let face_to_local = tile.placement.orientation.inverse();
+    let nside = SphereTiling::nside(tile.level as u32);
+    let mut seen: Vec<(Cell, (i32, i32), Orientation, u32)> = tile
+        .placement
+        .cells(tiling.shape())
+        .zip(tiling.shape().cells())
+        .map(|((i, j), &(u, v))| {
+            (
+                Cell {
+                    face: tile.face,
+                    i: i as i64,
+                    j: j as i64,
+                },
+                (2 * u + 1, 2 * v + 1),
+                face_to_local,
+                0,
+            )
+        })
+        .collect();
+    let mut head = 0;
+    while head < seen.len() {
+        let (cell, centre, frame, distance) = seen[head];
+        head += 1;
+        if distance == radius {
+            continue;
+        }
+        for local in LOCAL_DIRS {
+            let face_dir = dir_of(frame.inverse().apply(local));
+            let (next, rotation) = step_framed(cell, nside, face_dir);
+            if seen.iter().any(|s| s.0 == next) {
+                continue;
+            }
+            let centre = (centre.0 + 2 * local.0, centre.1 + 2 * local.1);
+            seen.push((next, centre, rotation.then(frame), distance + 1));
+        }
+    }
+    seen.into_iter()
+        .map(|(c, centre, frame, _)| (c, centre, frame))
+        .collect()
+}
+
+/// Looks up which tile (index into the tile list) and which of its cells
+/// covers a lattice cell; `None` outside the known tiles.
+type Owner<'a> = &'a (dyn Fn(Cell) -> Option<(usize, usize)> + Sync);
+
+/// The neighbourhood signature of a tile: the cells of its [`window`], each
+/// labelled with the owning tile's shape cell, orientation (in the tile's
+/// frame), rule and digit, the seams the cell touches and whether it touches
+/// a three-face corner. Tiles with equal signatures get one structural index.
+fn signature(
+    tiling: &SphereTiling,
+    tiles: &[SphereTile],
+    owner: Owner,
+    t: usize,
+    radius: u32,
+) -> Vec<(i16, i16, u32)> {
+    let tile = &tiles[t];
+    let nside = SphereTiling::nside(tile.level as u32);
+    let digit_weight = (ROOT_COUNT as u64) << (2 * (tile.level.max(1) as u32 - 1));
+    let mut signature: Vec<(i16, i16, u32)> = window(tiling, tile, radius)
+        .into_iter()
+        .map(|(cell, centre, frame)| {
+            let Some((owner_index, k)) = owner(cell) else {
+                return (centre.0 as i16, centre.1 as i16, u32::MAX);
+            };
+            let other = &tiles[owner_index];
+            let orientation = other.placement.orientation.then(frame).index() as u32;
+            let digit = (other.code / digit_weight) as u32;
+            let mut seams = 0u32;
+            for (bit, local) in LOCAL_DIRS.iter().enumerate() {
+                let face_dir = dir_of(frame.inverse().apply(*local));
+                if healpix::step(cell, nside, face_dir).0.face != cell.face {
+                    seams |= 1 << bit;
+                }
+            }
+            let at_edge = |v: i64| v == 0 || v == nside - 1;
+            let corner = at_edge(cell.i)
+                && at_edge(cell.j)
+                && healpix::is_three_face_corner(cell.face, (cell.i > 0, cell.j > 0));
+            let label = k as u32
+                | orientation << 3
+                | (other.rule as u32) << 6
+                | digit << 7
+                | seams << 9
+                | (corner as u32) << 13;
+            (centre.0 as i16, centre.1 as i16, label)
+        })
+        .collect();
+    signature.sort_unstable();
+    signature
+}
+
+/// The tiles around tile `t` (those owning a cell within `radius`), with
+/// the index of `t` among them.
+fn neighbourhood(
+    tiling: &SphereTiling,
+    tiles: &[SphereTile],
+    owner: Owner,
+    t: usize,
+    radius: u32,
+) -> (Vec<SphereTile>, usize) {
+    let mut chosen: Vec<usize> = window(tiling, &tiles[t], radius)
+        .into_iter()
+        .filter_map(|(cell, _, _)| owner(cell).map(|o| o.0))
+        .collect();
+    chosen.sort_unstable();
+    chosen.dedup();
+    let at = chosen
+        .iter()
+        .position(|&c| c == t)
+        .expect("a tile owns its own cells");
+    (chosen.iter().map(|&c| tiles[c]).collect(), at)
+}
+
+/// Owner lookup over an explicit list of tiles.
+fn local_owner(tiling: &SphereTiling, tiles: &[SphereTile]) -> HashMap<Cell, (usize, usize)> {
+    let mut map = HashMap::new();
+    for (t, tile) in tiles.iter().enumerate() {
+        for (k, (i, j)) in tile.placement.cells(tiling.shape()).enumerate() {
+            map.insert(
+                Cell {
+                    face: tile.face,
+                    i: i as i64,
+                    j: j as i64,
+                },
+                (t, k),
+            );
+        }
+    }
+    map
+}
+
+fn classify(
+    tiling: &SphereTiling,
+    options: &BuildOptions,
+    progress: Progress,
+    report: &mut BuildReport,
+) -> Classes {
+    let first = options.exact_levels as u32;
+    let last = options.class_depth as u32;
+    let mut ids: HashMap<Vec<(i16, i16, u32)>, u32> = HashMap::new();
+    let mut per_level = Vec::new();
+    let mut pending = std::collections::VecDeque::new();
+    let mut last_classes = Vec::new();
+    let total = (first..=last).map(|l| 4u64.pow(l)).sum::<u64>();
+    let mut done = 0;
+    for level in first..=last {
+        let tiles = tiles_at(tiling, level);
+        let map = CellMap::new(tiling, &tiles, level);
+        let owner = |cell: Cell| Some(map.get(cell));
+        let signatures: Vec<Vec<(i16, i16, u32)>> = (0..tiles.len())
+            .into_par_iter()
+            .map(|t| signature(tiling, &tiles, &owner, t, options.class_radius))
+            .collect();
+        let before = ids.len();
+        let classes: Vec<u32> = signatures
+            .into_iter()
+            .map(|s| {
+                let next = ids.len() as u32;
+                *ids.entry(s).or_insert(next)
+            })
+            .collect();
+        report.new_classes_per_level.push(ids.len() - before);
+        if level == last {
+            // classes first seen at the deepest level have no observed
+            // children yet: close the automaton around representatives
+            let mut has_children = vec![false; ids.len()];
+            for classes in &per_level {
+                for &c in classes {
+                    has_children[c as usize] = true;
+                }
+            }
+            let mut queued = has_children.clone();
+            for (t, &c) in classes.iter().enumerate() {
+                if !queued[c as usize] {
+                    queued[c as usize] = true;
+                    pending.push_back(neighbourhood(
+                        tiling,
+                        &tiles,
+                        &owner,
+                        t,
+                        options.class_radius + 3,
+                    ));
+                }
+            }
+            last_classes = classes;
+            per_level.push(last_classes.clone());
+        } else {
+            per_level.push(classes);
+        }
+        done += 4u64.pow(level);
+        progress("classes", done, total);
+    }
+    let mut extra: Vec<(u32, usize, u32)> = Vec::new();
+    let mut queued_classes: std::collections::HashSet<u32> = last_classes.iter().copied().collect();
+    for classes in &per_level[..per_level.len() - 1] {
+        queued_classes.extend(classes.iter().copied());
+    }
+    while let Some((local, rep)) = pending.pop_front() {
+        if local[rep].level as u32 >= 11 {
+            continue; // tree indices would overflow: counted as missing below
+        }
+        let parent_map = local_owner(tiling, &local);
+        let parent_owner = |cell: Cell| parent_map.get(&cell).copied();
+        let parent_class =
+            ids[&signature(tiling, &local, &parent_owner, rep, options.class_radius)];
+        let children: Vec<SphereTile> = local
+            .iter()
+            .flat_map(|t| (0..4).map(move |c| tiling.child(t, c)))
+            .collect();
+        let map = local_owner(tiling, &children);
+        let owner = |cell: Cell| map.get(&cell).copied();
+        for c in 0..4 {
+            let signature = signature(tiling, &children, &owner, rep * 4 + c, options.class_radius);
+            let next = ids.len() as u32;
+            let class = *ids.entry(signature).or_insert(next);
+            extra.push((parent_class, c, class));
+            if queued_classes.insert(class) {
+                pending.push_back(neighbourhood(
+                    tiling,
+                    &children,
+                    &owner,
+                    rep * 4 + c,
+                    options.class_radius + 3,
+                ));
+            }
+        }
+    }
+    report.classes_found_by_closure =
+        ids.len() - report.new_classes_per_level.iter().sum::<usize>();
+    let count = ids.len();
+    // majority vote of the observed transitions
+    let mut votes: Vec<[HashMap<u32, usize>; 4]> = (0..count).map(|_| Default::default()).collect();
+    for l in 0..per_level.len() - 1 {
+        for (i, &child_class) in per_level[l + 1].iter().enumerate() {
+            *votes[per_level[l][i / 4] as usize][i % 4]
+                .entry(child_class)
+                .or_default() += 1;
+        }
+    }
+    for (parent, c, child) in extra {
+        *votes[parent as usize][c].entry(child).or_default() += 1;
+    }
+    let mut transitions = vec![[0u32; 4]; count];
+    for (class, class_votes) in votes.iter().enumerate() {
+        for c in 0..4 {
+            let total: usize = class_votes[c].values().sum();
+            match class_votes[c]
+                .iter()
+                .max_by_key(|(k, v)| (**v, std::cmp::Reverse(**k)))
+            {
+                Some((&winner, &n)) => {
+                    transitions[class][c] = winner;
+                    report.transition_conflicts += total - n;
+                }
+                None => {
+                    // never observed (a class first seen at the deepest level):
+                    // fall back to the class itself, which keeps the automaton total
+                    transitions[class][c] = class as u32;
+                    report.missing_transitions += 1;
+                }
+            }
+        }
+    }
+    let entry = per_level[0]
+        .chunks(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    Classes {
+        entry,
+        transitions,
+        per_level,
+    }
+}
+
+// ---------------------------------------------------------------- Lloyd ----
+
+/// One table per level: rows are tiles (exact levels) or classes.
+fn relax(
+    tiling: &SphereTiling,
+    lut: &SphereLut,
+    class_per_level: &[Vec<u32>],
+    options: &BuildOptions,
+    progress: Progress,
+    report: &mut BuildReport,
+) -> Vec<Vec<[f32; 2]>> {
+    let shape = tiling.shape().clone();
+    let bins = options.bins as usize;
+    let centroid = shape.centroid();
+    let mut tables: Vec<Vec<[f32; 2]>> = Vec::new();
+    let total: u64 = (0..options.table_levels as u64)
+        .map(|l| bins as u64 * 4u64.pow(l as u32))
+        .sum();
+    let mut done = 0;
+    for level in 0..options.table_levels as u32 {
+        let tiles = tiles_at(tiling, level);
+        let exact = level < options.exact_levels as u32;
+        let rows: Vec<u32> = if exact {
+            (0..tiles.len() as u32).collect()
+        } else {
+            let l = (level - options.exact_levels as u32) as usize;
+            class_per_level[l.min(class_per_level.len() - 1)].clone()
+        };
+        let row_count = if exact {
+            tiles.len()
+        } else {
+            lut.transitions.len()
+        };
+        // start from the previous level's converged offsets where the row exists
+        let start: Vec<[f64; 2]> = match tables.last() {
+            Some(previous) if !exact && previous.len() == row_count * bins => previous
+                .iter()
+                .map(|o| [o[0] as f64, o[1] as f64])
+                .collect(),
+            _ => vec![centroid; row_count * bins],
+        };
+        let mut table = start.clone();
+        let mut residual = 0.0;
+        for bin in 0..bins {
+            let fraction = fraction_of_bin(bin, bins);
+            let (offsets, r) = relax_bin(
+                tiling,
+                &tiles,
+                &rows,
+                row_count,
+                bins,
+                bin,
+                fraction,
+                &start,
+                options.iterations,
+                level,
+            );
+            residual += r / bins as f64;
+            for row in 0..row_count {
+                if let Some(o) = offsets[row] {
+                    table[row * bins + bin] = o;
+                }
+            }
+            done += 4u64.pow(level);
+            progress("lloyd", done, total);
+        }
+        report.lloyd_residual.push(residual);
+        tables.push(table.iter().map(|o| [o[0] as f32, o[1] as f32]).collect());
+    }
+    tables
+}
+
+/// Lloyd iterations for one level and one importance bin; returns the new
+/// offset of every row that had an accepted tile, and the mean squared
+/// displacement (cells^2) of the last iteration.
+#[allow(clippy::too_many_arguments)]
+fn relax_bin(
+    tiling: &SphereTiling,
+    tiles: &[SphereTile],
+    rows: &[u32],
+    row_count: usize,
+    bins: usize,
+    bin: usize,
+    fraction: f64,
+    start: &[[f64; 2]],
+    iterations: usize,
+    level: u32,
+) -> (Vec<Option<[f64; 2]>>, f64) {
+    let shape = tiling.shape();
+    let capacity = ROOT_COUNT as f64 * 4f64.powi(level as i32);
+    let accepted: Vec<usize> = (0..tiles.len())
+        .filter(|&t| (tiles[t].code as f64) < fraction * capacity)
+        .collect();
+    let mut offsets: Vec<Option<[f64; 2]>> = (0..row_count)
+        .map(|r| Some(start[r * bins + bin]))
+        .collect();
+    // quadrature: cell centres of a finer HEALPix grid, at least ~40 per site
+    let per_cell = if level <= 3 { 6 } else { 3 };
+    let qside = SphereTiling::nside(level) * per_cell;
+    let mut residual = 0.0;
+    for _ in 0..iterations {
+        let sites: Vec<DVec3> = accepted
+            .iter()
+            .map(|&t| {
+                tiling
+                    .face_point(&tiles[t], offsets[rows[t] as usize].unwrap())
+                    .to_vec()
+            })
+            .collect();
+        let points: Vec<[f64; 3]> = sites.iter().map(|v| v.to_array()).collect();
+        let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(&points);
+        // deterministic: each block of rows sums in order, blocks merge in order
+        let blocks: Vec<HashMap<u32, DVec3>> = (0..12 * qside)
+            .into_par_iter()
+            .map(|row| {
+                let (face, j) = ((row / qside) as u8, row % qside);
+                let mut sums: HashMap<u32, DVec3> = HashMap::new();
+                for i in 0..qside {
+                    let q = FacePoint::new(
+                        face,
+                        (i as f64 + 0.5) / qside as f64,
+                        (j as f64 + 0.5) / qside as f64,
+                    )
+                    .to_vec();
+                    let nearest = tree.nearest_one::<SquaredEuclidean>(&q.to_array()).item;
+                    *sums.entry(nearest).or_default() += q;
+                }
+                sums
+            })
+            .collect();
+        let mut sums = vec![DVec3::ZERO; sites.len()];
+        for block in blocks {
+            let mut entries: Vec<(u32, DVec3)> = block.into_iter().collect();
+            entries.sort_unstable_by_key(|e| e.0);
+            for (site, s) in entries {
+                sums[site as usize] += s;
+            }
+        }
+        // move each site to its centroid, expressed in its tile's frame
+        let mut row_sum = vec![[0.0f64; 2]; row_count];
+        let mut row_n = vec![0usize; row_count];
+        residual = 0.0;
+        for (k, &t) in accepted.iter().enumerate() {
+            let row = rows[t] as usize;
+            let current = offsets[row].unwrap();
+            let target = if sums[k] == DVec3::ZERO {
+                sites[k]
+            } else {
+                sums[k].normalize()
+            };
+            let local = to_local(tiling, &tiles[t], current, sites[k], target);
+            row_sum[row][0] += local[0];
+            row_sum[row][1] += local[1];
+            row_n[row] += 1;
+        }
+        let mut moved = 0;
+        for row in 0..row_count {
+            if row_n[row] == 0 {
+                offsets[row] = None;
+                continue;
+            }
+            let mean = [
+                row_sum[row][0] / row_n[row] as f64,
+                row_sum[row][1] / row_n[row] as f64,
+            ];
+            let new = shape.clamp(mean, 0.02);
+            if let Some(old) = offsets[row] {
+                residual += (new[0] - old[0]).powi(2) + (new[1] - old[1]).powi(2);
+                moved += 1;
+            }
+            offsets[row] = Some(new);
+        }
+        residual /= moved.max(1) as f64;
+        // rows never accepted keep their start value for the next iteration
+        for row in 0..row_count {
+            if offsets[row].is_none() {
+                offsets[row] = Some(start[row * bins + bin]);
+            }
+        }
+    }
+    let present: Vec<bool> = {
+        let mut p = vec![false; row_count];
+        for &t in &accepted {
+            p[rows[t] as usize] = true;
+        }
+        p
+    };
+    let offsets = offsets
+        .into_iter()
+        .zip(present)
+        .map(|(o, p)| if p { o } else { None })
+        .collect();
+    (offsets, residual)
+}
+
+/// The tile-frame point whose image is (to first order) `target`, from the
+/// current offset whose image is `site`: one Gauss-Newton step through the
+/// mapping's Jacobian, which stays valid across seams.
+fn to_local(
+    tiling: &SphereTiling,
+    tile: &SphereTile,
+    current: [f64; 2],
+    site: DVec3,
+    target: DVec3,
+) -> [f64; 2] {
+    let h = 1e-3;
+    let du = tiling
+        .face_point(tile, [current[0] + h, current[1]])
+        .to_vec()
+        - site;
+    let dv = tiling
+        .face_point(tile, [current[0], current[1] + h])
+        .to_vec()
+        - site;
+    let d = target - site;
+    // least squares: [du dv] [a b]^T = d
+    let (a11, a12, a22) = (du.dot(du), du.dot(dv), dv.dot(dv));
+    let (b1, b2) = (du.dot(d), dv.dot(d));
+    let det = a11 * a22 - a12 * a12;
+    if det.abs() < 1e-300 {
+        return current;
+    }
+    let a = (b1 * a22 - b2 * a12) / det;
+    let b = (a11 * b2 - a12 * b1) / det;
+    [current[0] + a * h, current[1] + b * h]
+}

@@ -1,0 +1,137 @@
+//! The builder most users start from.
+
+use crate::density::{Density, Region, Uniform};
+use crate::engine::{self, Sample};
+use crate::tiling::sphere::SphereTiling;
+use crate::tiling::TileSystem;
+use crate::Error;
+
+/// A configured sampling request: a tile system, a density and a count.
+///
+/// # Example
+/// ```
+/// use tessera::Sampler;
+/// let points = Sampler::sphere().count(3072).generate().unwrap();
+/// assert_eq!(points.len(), 3072);
+/// ```
+#[derive(Clone)]
+pub struct Sampler<S, D> {
+    system: S,
+    density: D,
+    count: usize,
+    exact: bool,
+}
+
+impl Sampler<SphereTiling, Uniform> {
+    /// Uniform sampling of the unit sphere with the shipped tables.
+    ///
+    /// # Example
+    /// ```
+    /// let s = tessera::Sampler::sphere().count(10).generate().unwrap();
+    /// assert!(s.iter().all(|p| (p.position.length() - 1.0).abs() < 1e-12));
+    /// ```
+    pub fn sphere() -> Self {
+        Sampler::new(SphereTiling::default())
+    }
+}
+
+impl<S: TileSystem> Sampler<S, Uniform> {
+    /// Uniform sampling over any tile system.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{tiling::sphere::SphereTiling, Sampler};
+    /// let s = Sampler::new(SphereTiling::default()).count(5).generate().unwrap();
+    /// assert_eq!(s.len(), 5);
+    /// ```
+    pub fn new(system: S) -> Self {
+        Sampler {
+            system,
+            density: Uniform,
+            count: 0,
+            exact: true,
+        }
+    }
+}
+
+impl<S, D> Sampler<S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region>,
+{
+    /// Replaces the density.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::sphere::Cap, Sampler};
+    /// let cap = Cap::new(0.0, 0.0, 10.0, 5.0).unwrap();
+    /// assert_eq!(Sampler::sphere().density(cap).count(7).generate().unwrap().len(), 7);
+    /// ```
+    pub fn density<E: Density<S::Region>>(self, density: E) -> Sampler<S, E> {
+        Sampler {
+            system: self.system,
+            density,
+            count: self.count,
+            exact: self.exact,
+        }
+    }
+
+    /// Sets the number of samples.
+    ///
+    /// # Example
+    /// ```
+    /// assert!(tessera::Sampler::sphere().count(0).generate().unwrap().is_empty());
+    /// ```
+    pub fn count(mut self, count: usize) -> Self {
+        self.count = count;
+        self
+    }
+
+    /// Skips the exactness pass: returns the natural count, near the requested one.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::sphere::Cap, Sampler};
+    /// let cap = Cap::new(0.0, 0.0, 10.0, 5.0).unwrap();
+    /// let n = Sampler::sphere().density(cap).count(1000).expected().generate().unwrap().len();
+    /// assert!((900..1100).contains(&n));
+    /// ```
+    pub fn expected(mut self) -> Self {
+        self.exact = false;
+        self
+    }
+
+    /// Runs the recursion; samples come in progressive order.
+    ///
+    /// # Example
+    /// ```
+    /// let s = tessera::Sampler::sphere().count(100).generate().unwrap();
+    /// assert!(s.windows(2).all(|w| w[0].rank <= w[1].rank));
+    /// ```
+    pub fn generate(&self) -> Result<Vec<Sample<S::Point>>, Error> {
+        engine::generate(&self.system, &self.density, self.count, self.exact)
+    }
+
+    /// The pdf (per unit measure) the samples follow at `point`.
+    ///
+    /// # Example
+    /// ```
+    /// let p = tessera::Sampler::sphere().pdf(glam::DVec3::X);
+    /// assert!((p * 4.0 * std::f64::consts::PI - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn pdf(&self, point: S::Point) -> f64 {
+        engine::pdf(&self.system, &self.density, point)
+    }
+
+    /// The tile system.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::TileSystem;
+    /// assert_eq!(tessera::Sampler::sphere().system().roots().len(), 240);
+    /// ```
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+}

@@ -1,0 +1,519 @@
+//! Polyomino geometry: shapes made of unit cells, the 8 orientations of the
+//! square lattice, placements, and rep-tile production rules.
+//!
+//! A point `p` in a tile's own frame (cell units) sits at `origin + T p` in the
+//! lattice, with `T` one of the 8 orthogonal integer matrices. Children of a
+//! `scale`-rep tile live on the lattice refined `scale` times.
+
+use serde::{Deserialize, Serialize};
+
+/// One of the 8 symmetries of the square lattice: `r` quarter turns
+/// counter-clockwise applied after an optional mirror `x -> -x`.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::polyomino::Orientation;
+/// let quarter = Orientation::new(1, false);
+/// assert_eq!(quarter.apply((1, 0)), (0, 1));
+/// assert_eq!(quarter.then(quarter).then(quarter).then(quarter), Orientation::IDENTITY);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Orientation(u8);
+
+impl Orientation {
+    /// The identity.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::IDENTITY.apply((2, 3)), (2, 3));
+    /// ```
+    pub const IDENTITY: Orientation = Orientation(0);
+
+    /// All 8 orientations, index order.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::ALL.len(), 8);
+    /// ```
+    pub const ALL: [Orientation; 8] = [
+        Orientation(0),
+        Orientation(1),
+        Orientation(2),
+        Orientation(3),
+        Orientation(4),
+        Orientation(5),
+        Orientation(6),
+        Orientation(7),
+    ];
+
+    /// `turns` quarter turns (mod 4) after an optional mirror.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::new(2, true).apply((1, 2)), (1, -2));
+    /// ```
+    pub fn new(turns: u8, mirrored: bool) -> Self {
+        Orientation((turns % 4) | if mirrored { 4 } else { 0 })
+    }
+
+    /// Index in `0..8` (for tables).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::new(3, true).index(), 7);
+    /// ```
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// The orientation with the given index (`index % 8`).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::from_index(5).index(), 5);
+    /// ```
+    pub fn from_index(index: usize) -> Self {
+        Orientation((index % 8) as u8)
+    }
+
+    /// The integer matrix `[[a, b], [c, d]]` acting on column vectors.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::IDENTITY.matrix(), [[1, 0], [0, 1]]);
+    /// ```
+    pub fn matrix(self) -> [[i32; 2]; 2] {
+        let mirror = if self.0 & 4 != 0 { -1 } else { 1 };
+        let (c, s) = match self.0 & 3 {
+            0 => (1, 0),
+            1 => (0, 1),
+            2 => (-1, 0),
+            _ => (0, -1),
+        };
+        // rotation * diag(mirror, 1)
+        [[c * mirror, -s], [s * mirror, c]]
+    }
+
+    /// Applies the orientation to an integer vector.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::new(0, true).apply((1, 1)), (-1, 1));
+    /// ```
+    pub fn apply(self, v: (i32, i32)) -> (i32, i32) {
+        let m = self.matrix();
+        (m[0][0] * v.0 + m[0][1] * v.1, m[1][0] * v.0 + m[1][1] * v.1)
+    }
+
+    /// Applies the orientation to a real vector.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// assert_eq!(Orientation::new(1, false).apply_f64([0.5, 0.0]), [0.0, 0.5]);
+    /// ```
+    pub fn apply_f64(self, v: [f64; 2]) -> [f64; 2] {
+        let m = self.matrix();
+        [
+            m[0][0] as f64 * v[0] + m[0][1] as f64 * v[1],
+            m[1][0] as f64 * v[0] + m[1][1] as f64 * v[1],
+        ]
+    }
+
+    /// The composition "first `self`, then `outer`" (matrix `outer * self`).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// let (a, b) = (Orientation::new(1, false), Orientation::new(0, true));
+    /// assert_eq!(a.then(b).apply((1, 0)), b.apply(a.apply((1, 0))));
+    /// ```
+    pub fn then(self, outer: Orientation) -> Orientation {
+        let (a, b) = (outer.matrix(), self.matrix());
+        let product = [
+            [
+                a[0][0] * b[0][0] + a[0][1] * b[1][0],
+                a[0][0] * b[0][1] + a[0][1] * b[1][1],
+            ],
+            [
+                a[1][0] * b[0][0] + a[1][1] * b[1][0],
+                a[1][0] * b[0][1] + a[1][1] * b[1][1],
+            ],
+        ];
+        *Orientation::ALL
+            .iter()
+            .find(|o| o.matrix() == product)
+            .expect("D4 is closed under composition")
+    }
+
+    /// The inverse orientation.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Orientation;
+    /// let o = Orientation::new(1, true);
+    /// assert_eq!(o.then(o.inverse()), Orientation::IDENTITY);
+    /// ```
+    pub fn inverse(self) -> Orientation {
+        *Orientation::ALL
+            .iter()
+            .find(|o| o.then(self) == Orientation::IDENTITY)
+            .expect("every element of D4 has an inverse")
+    }
+}
+
+/// A polyomino: a finite set of unit cells given by their lower-left corners.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::polyomino::Shape;
+/// let p = Shape::p_pentomino();
+/// assert_eq!(p.cells().len(), 5);
+/// assert_eq!(p.bounding_size(), (2, 3));
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shape {
+    cells: Vec<(i32, i32)>,
+}
+
+impl Shape {
+    /// A shape from its cells (lower-left corners), kept in the given order.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::new(vec![(0, 0), (1, 0)]).cells().len(), 2);
+    /// ```
+    pub fn new(cells: Vec<(i32, i32)>) -> Self {
+        Shape { cells }
+    }
+
+    /// The P-pentomino `XX / XX / X.` (a 2x2 block with one cell below its
+    /// left column), as cells `(0,0) (0,1) (1,1) (0,2) (1,2)` with y up.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert!(Shape::p_pentomino().cells().contains(&(0, 0)));
+    /// ```
+    pub fn p_pentomino() -> Self {
+        Shape::new(vec![(0, 0), (0, 1), (1, 1), (0, 2), (1, 2)])
+    }
+
+    /// The G-hexomino `X.. / XXX / XX.` (top row first), y up.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::g_hexomino().cells().len(), 6);
+    /// ```
+    pub fn g_hexomino() -> Self {
+        Shape::new(vec![(0, 0), (1, 0), (0, 1), (1, 1), (2, 1), (0, 2)])
+    }
+
+    /// The cells, lower-left corners.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::p_pentomino().cells()[0], (0, 0));
+    /// ```
+    pub fn cells(&self) -> &[(i32, i32)] {
+        &self.cells
+    }
+
+    /// Width and height of the bounding box in cells (assumes min corner 0).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::g_hexomino().bounding_size(), (3, 3));
+    /// ```
+    pub fn bounding_size(&self) -> (i32, i32) {
+        let w = self.cells.iter().map(|c| c.0).max().unwrap_or(-1) + 1;
+        let h = self.cells.iter().map(|c| c.1).max().unwrap_or(-1) + 1;
+        (w, h)
+    }
+
+    /// The shape scaled by an integer factor (each cell becomes a block).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::p_pentomino().scaled(2).cells().len(), 20);
+    /// ```
+    pub fn scaled(&self, factor: i32) -> Shape {
+        let mut cells = Vec::with_capacity(self.cells.len() * (factor * factor) as usize);
+        for &(x, y) in &self.cells {
+            for dy in 0..factor {
+                for dx in 0..factor {
+                    cells.push((x * factor + dx, y * factor + dy));
+                }
+            }
+        }
+        Shape::new(cells)
+    }
+
+    /// Centroid of the cells, in the shape's frame (cell units).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::new(vec![(0, 0), (1, 0)]).centroid(), [1.0, 0.5]);
+    /// ```
+    pub fn centroid(&self) -> [f64; 2] {
+        let n = self.cells.len() as f64;
+        let sx: f64 = self.cells.iter().map(|c| c.0 as f64 + 0.5).sum();
+        let sy: f64 = self.cells.iter().map(|c| c.1 as f64 + 0.5).sum();
+        [sx / n, sy / n]
+    }
+
+    /// Whether a point of the shape's frame lies in the closed shape.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// let p = Shape::p_pentomino();
+    /// assert!(p.contains([0.5, 0.5]));
+    /// assert!(!p.contains([1.5, 0.5]));
+    /// ```
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        self.cells.iter().any(|&(x, y)| {
+            p[0] >= x as f64 && p[0] <= x as f64 + 1.0 && p[1] >= y as f64 && p[1] <= y as f64 + 1.0
+        })
+    }
+
+    /// The closest point of the shape, shrunk by `margin` cells, to `p`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// let q = Shape::p_pentomino().clamp([1.7, 0.2], 0.01);
+    /// assert!(Shape::p_pentomino().contains(q));
+    /// ```
+    pub fn clamp(&self, p: [f64; 2], margin: f64) -> [f64; 2] {
+        let mut best = p;
+        let mut best_d = f64::INFINITY;
+        for &(x, y) in &self.cells {
+            let q = [
+                p[0].clamp(x as f64 + margin, x as f64 + 1.0 - margin),
+                p[1].clamp(y as f64 + margin, y as f64 + 1.0 - margin),
+            ];
+            let d = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+            if d < best_d {
+                best_d = d;
+                best = q;
+            }
+        }
+        best
+    }
+}
+
+/// A copy of a shape on the lattice: shape-frame point `p` lies at
+/// `origin + orientation * p`.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::polyomino::{Orientation, Placement, Shape};
+/// let p = Placement::new((5, 0), Orientation::new(1, false));
+/// let cells: Vec<_> = p.cells(&Shape::new(vec![(0, 0), (1, 0)])).collect();
+/// assert_eq!(cells, vec![(4, 0), (4, 1)]);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Placement {
+    /// Lattice point that the shape frame's origin maps to.
+    pub origin: (i32, i32),
+    /// Orientation of the copy.
+    pub orientation: Orientation,
+}
+
+impl Placement {
+    /// A placement from its origin and orientation.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// assert_eq!(Placement::new((1, 2), Orientation::IDENTITY).origin, (1, 2));
+    /// ```
+    pub fn new(origin: (i32, i32), orientation: Orientation) -> Self {
+        Placement {
+            origin,
+            orientation,
+        }
+    }
+
+    /// Lower-left corners of the lattice cells covered by `shape` so placed.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::{Orientation, Placement, Shape};
+    /// let p = Placement::new((0, 0), Orientation::new(2, false));
+    /// let cells: Vec<_> = p.cells(&Shape::new(vec![(0, 0)])).collect();
+    /// assert_eq!(cells, vec![(-1, -1)]);
+    /// ```
+    pub fn cells<'a>(&self, shape: &'a Shape) -> impl Iterator<Item = (i32, i32)> + 'a {
+        let (origin, orientation) = (self.origin, self.orientation);
+        shape
+            .cells()
+            .iter()
+            .map(move |&c| cell_image(origin, orientation, c))
+    }
+
+    /// Maps a shape-frame point to lattice coordinates.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// let p = Placement::new((2, 0), Orientation::new(1, false));
+    /// assert_eq!(p.to_lattice([1.0, 0.5]), [1.5, 1.0]);
+    /// ```
+    pub fn to_lattice(&self, p: [f64; 2]) -> [f64; 2] {
+        let q = self.orientation.apply_f64(p);
+        [self.origin.0 as f64 + q[0], self.origin.1 as f64 + q[1]]
+    }
+
+    /// The placement of a child given in this tile's `scale`-refined frame,
+    /// on the `scale`-refined lattice.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// let parent = Placement::new((1, 1), Orientation::IDENTITY);
+    /// let child = parent.child(&Placement::new((1, 0), Orientation::IDENTITY), 2);
+    /// assert_eq!(child.origin, (3, 2));
+    /// ```
+    pub fn child(&self, child: &Placement, scale: i32) -> Placement {
+        let o = self.orientation.apply(child.origin);
+        Placement {
+            origin: (scale * self.origin.0 + o.0, scale * self.origin.1 + o.1),
+            orientation: child.orientation.then(self.orientation),
+        }
+    }
+}
+
+/// Lower-left corner of the image of cell `c` under `origin + orientation`.
+fn cell_image(origin: (i32, i32), orientation: Orientation, c: (i32, i32)) -> (i32, i32) {
+    let doubled = orientation.apply((2 * c.0 + 1, 2 * c.1 + 1));
+    (
+        origin.0 + (doubled.0 - 1) / 2,
+        origin.1 + (doubled.1 - 1) / 2,
+    )
+}
+
+/// A rep-tile production rule: the children of a tile, given as placements
+/// in the parent's frame refined `scale` times, each with the rule its own
+/// children use and its rank among siblings (the code digit).
+///
+/// # Example
+/// ```
+/// use tessera::tiling::polyomino::{Shape, Rule};
+/// let rules = Rule::p_pentomino_rules();
+/// assert_eq!(rules.len(), 2);
+/// assert!(rules[0].tiles_parent(&Shape::p_pentomino()));
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Rule {
+    /// Linear scale factor between parent and children.
+    pub scale: i32,
+    /// Child placements in the parent's refined frame.
+    pub children: Vec<Placement>,
+}
+
+impl Rule {
+    /// Whether the children cover the `scale`-times enlarged parent exactly,
+    /// cell by cell.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::{Shape, Rule};
+    /// for rule in Rule::p_pentomino_rules() {
+    ///     assert!(rule.tiles_parent(&Shape::p_pentomino()));
+    /// }
+    /// ```
+    pub fn tiles_parent(&self, shape: &Shape) -> bool {
+        let mut target: Vec<(i32, i32)> = shape.scaled(self.scale).cells().to_vec();
+        let mut covered: Vec<(i32, i32)> = self
+            .children
+            .iter()
+            .flat_map(|p| p.cells(shape).collect::<Vec<_>>())
+            .collect();
+        target.sort_unstable();
+        covered.sort_unstable();
+        target == covered
+    }
+
+    /// The two dissections of the doubled P-pentomino into four P-pentominoes,
+    /// found by exact-cover search (there are exactly two).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Rule;
+    /// assert_ne!(Rule::p_pentomino_rules()[0], Rule::p_pentomino_rules()[1]);
+    /// ```
+    pub fn p_pentomino_rules() -> Vec<Rule> {
+        let shape = Shape::p_pentomino();
+        let region = shape.scaled(2).cells().to_vec();
+        let mut found = crate::optimize::exact_cover::tilings(&shape, &region, usize::MAX, 0);
+        for children in &mut found {
+            children.sort_by_key(|p| (p.origin, p.orientation));
+        }
+        found.sort_by_key(|c| {
+            c.iter()
+                .map(|p| (p.origin, p.orientation))
+                .collect::<Vec<_>>()
+        });
+        found
+            .into_iter()
+            .map(|children| Rule { scale: 2, children })
+            .collect()
+    }
+}
+
+impl Shape {
+    /// The outline as a closed loop of lattice vertices, counter-clockwise,
+    /// one vertex per unit step (assumes a simply connected shape).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::new(vec![(0, 0)]).outline(), vec![(0, 0), (1, 0), (1, 1), (0, 1)]);
+    /// assert_eq!(Shape::p_pentomino().outline().len(), 10);
+    /// ```
+    pub fn outline(&self) -> Vec<(i32, i32)> {
+        use std::collections::HashMap;
+        let has = |c: (i32, i32)| self.cells.contains(&c);
+        // directed boundary edges with the shape on their left
+        let mut next: HashMap<(i32, i32), (i32, i32)> = HashMap::new();
+        for &(x, y) in &self.cells {
+            if !has((x, y - 1)) {
+                next.insert((x, y), (x + 1, y));
+            }
+            if !has((x + 1, y)) {
+                next.insert((x + 1, y), (x + 1, y + 1));
+            }
+            if !has((x, y + 1)) {
+                next.insert((x + 1, y + 1), (x, y + 1));
+            }
+            if !has((x - 1, y)) {
+                next.insert((x, y + 1), (x, y));
+            }
+        }
+        let Some(&start) = next.keys().min() else {
+            return Vec::new();
+        };
+        let mut loop_ = vec![start];
+        let mut at = next[&start];
+        while at != start && loop_.len() <= next.len() {
+            loop_.push(at);
+            at = next[&at];
+        }
+        loop_
+    }
+}

@@ -1,0 +1,295 @@
+//! The sphere tile system: P-pentominoes on the 12 HEALPix base faces.
+//!
+//! Each face carries a 10x10 cell grid (HEALPix Nside 10) tiled by 20
+//! P-pentominoes; each pentomino splits into 4 by one of the two dissections
+//! of the doubled P-pentomino, so level `k` has `240 * 4^k` tiles of 5 cells at
+//! Nside `10 * 2^k`. Because HEALPix is equal-area, uniform density in face
+//! coordinates is uniform density on the sphere.
+//!
+//! Structural indices: at the shallow levels where the mapping's distortion
+//! differs from tile to tile, every tile is its own index (its position in
+//! the subdivision tree). Deeper, the index names the tile's neighbourhood
+//! class (computed offline, across face seams and the three-face corners) and
+//! follows the automaton `child index = transitions[index][child]`.
+
+use crate::healpix::FacePoint;
+use crate::lut::SphereLut;
+use crate::tiling::polyomino::{Placement, Shape};
+use crate::tiling::TileSystem;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
+pub const PATCH_SIDE: i32 = 10;
+/// Pentominoes per face at level 0.
+pub const ROOTS_PER_FACE: usize = 20;
+/// Number of level-0 tiles on the sphere.
+pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
+/// Deepest supported level: lattice coordinates `10 * 2^k` stay in `i32` and
+/// codes `240 * 4^k` in `u64`; tiles are about 1.5e-9 rad across.
+pub const MAX_LEVEL: u32 = 26;
+/// Upper bound of the geodesic length (radians) of a unit step in face
+/// coordinates, anywhere on any face (measured by `tests/sphere.rs`: 1.47).
+pub const FACE_LIPSCHITZ: f64 = 1.6;
+/// Largest distance from the P-pentomino's centroid to its outline, cells.
+const PENTOMINO_RADIUS: f64 = 2.03;
+
+/// A pentomino of the sphere tiling.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+/// let sphere = SphereTiling::default();
+/// let root = sphere.roots()[0];
+/// assert_eq!(root.level, 0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SphereTile {
+    /// HEALPix base face, 0..12.
+    pub face: u8,
+    /// Subdivision level.
+    pub level: u8,
+    /// Which of the two dissections this tile's children follow.
+    pub rule: u8,
+    /// Position on the face lattice at Nside `10 * 2^level`.
+    pub placement: Placement,
+    /// Structural index (tree position at shallow levels, class deeper).
+    pub index: u32,
+    /// Threshold code, `0..240 * 4^level`.
+    pub code: u64,
+}
+
+/// A tile as a density sees it: its face, cell-centre probes and a
+/// conservative bounding cap.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+/// let sphere = SphereTiling::default();
+/// let region = sphere.region(&sphere.roots()[0]);
+/// assert!(region.radius > 0.0 && region.radius < 0.5);
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct SphereRegion {
+    /// The tile's centroid on the sphere.
+    pub center: DVec3,
+    /// Angular radius (rad) of a cap around `center` containing the tile.
+    pub radius: f64,
+    /// Base face.
+    pub face: u8,
+    /// Face coordinates of the five cell centres.
+    pub cells: [[f64; 2]; 5],
+}
+
+impl SphereRegion {
+    /// The five cell centres as unit vectors (an equal-weight quadrature).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let probes = sphere.region(&sphere.roots()[3]).probes();
+    /// assert!(probes.iter().all(|p| (p.length() - 1.0).abs() < 1e-12));
+    /// ```
+    pub fn probes(&self) -> [DVec3; 5] {
+        self.cells
+            .map(|[x, y]| FacePoint::new(self.face, x, y).to_vec())
+    }
+}
+
+/// The sphere tile system, driven by an offset table ([`SphereLut`]).
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+/// let sphere = SphereTiling::default();
+/// assert_eq!(sphere.child_count(&sphere.roots()[0]), 4);
+/// ```
+#[derive(Clone)]
+pub struct SphereTiling {
+    lut: Arc<SphereLut>,
+    shape: Shape,
+}
+
+impl Default for SphereTiling {
+    /// The tiling with the table shipped in `luts/` and embedded at compile time.
+    fn default() -> Self {
+        SphereTiling::new(crate::lut::sphere_lut())
+    }
+}
+
+impl SphereTiling {
+    /// A tiling driven by the given table.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// let sphere = SphereTiling::new(tessera::lut::sphere_lut());
+    /// assert_eq!(sphere.lut().rules.len(), 2);
+    /// ```
+    pub fn new(lut: Arc<SphereLut>) -> Self {
+        SphereTiling {
+            lut,
+            shape: Shape::p_pentomino(),
+        }
+    }
+
+    /// The table driving this tiling.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// assert_eq!(SphereTiling::default().lut().root_rank.len(), 240);
+    /// ```
+    pub fn lut(&self) -> &SphereLut {
+        &self.lut
+    }
+
+    /// Lattice resolution (cells per face edge) at `level`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// assert_eq!(SphereTiling::nside(2), 40);
+    /// ```
+    pub fn nside(level: u32) -> i64 {
+        (PATCH_SIDE as i64) << level
+    }
+
+    fn subdivide(&self, tile: &SphereTile, child: usize) -> SphereTile {
+        let lut = &*self.lut;
+        let rule = tile.rule as usize;
+        let level = tile.level as u32;
+        let index = if level + 1 < lut.exact_levels as u32 {
+            tile.index * 4 + child as u32
+        } else if level + 1 == lut.exact_levels as u32 {
+            lut.entry_class[tile.index as usize][child]
+        } else {
+            lut.transitions[tile.index as usize][child]
+        };
+        let digit = lut.child_digit[rule][child] as u64;
+        SphereTile {
+            face: tile.face,
+            level: tile.level + 1,
+            rule: lut.child_rule[rule][child],
+            placement: tile.placement.child(&lut.rules[rule].children[child], 2),
+            index,
+            code: tile.code + digit * ((ROOT_COUNT as u64) << (2 * level)),
+        }
+    }
+
+    /// Face coordinates of a point given in the tile's own frame (cells).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let fp = sphere.face_point(&sphere.roots()[0], [0.5, 0.5]);
+    /// assert!(fp.x > 0.0 && fp.x < 1.0 && fp.y > 0.0 && fp.y < 1.0);
+    /// ```
+    pub fn face_point(&self, tile: &SphereTile, local: [f64; 2]) -> FacePoint {
+        let lattice = tile.placement.to_lattice(local);
+        let scale = 1.0 / Self::nside(tile.level as u32) as f64;
+        FacePoint::new(
+            tile.face,
+            (lattice[0] * scale).clamp(0.0, 1.0),
+            (lattice[1] * scale).clamp(0.0, 1.0),
+        )
+    }
+
+    /// The table offset (tile frame, cells) for a tile at the given density
+    /// fraction.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let o = sphere.offset(&sphere.roots()[0], 1.0);
+    /// assert!(tessera::tiling::polyomino::Shape::p_pentomino().contains(o));
+    /// ```
+    pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
+        let lut = &*self.lut;
+        let table = &lut.tables[(tile.level as usize).min(lut.tables.len() - 1)];
+        let o = table[tile.index as usize * lut.bins as usize + lut.bin(fraction)];
+        [o[0] as f64, o[1] as f64]
+    }
+
+    /// The shape of every tile.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// assert_eq!(SphereTiling::default().shape().cells().len(), 5);
+    /// ```
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+}
+
+impl TileSystem for SphereTiling {
+    type Tile = SphereTile;
+    type Point = DVec3;
+    type Region = SphereRegion;
+
+    fn roots(&self) -> Vec<SphereTile> {
+        let lut = &*self.lut;
+        (0..ROOT_COUNT)
+            .map(|r| SphereTile {
+                face: (r / ROOTS_PER_FACE) as u8,
+                level: 0,
+                rule: lut.root_rule[r],
+                placement: lut.patch[r % ROOTS_PER_FACE],
+                index: r as u32,
+                code: lut.root_rank[r] as u64,
+            })
+            .collect()
+    }
+
+    fn child_count(&self, _: &SphereTile) -> usize {
+        4
+    }
+
+    fn child(&self, tile: &SphereTile, i: usize) -> SphereTile {
+        self.subdivide(tile, i)
+    }
+
+    fn measure(&self) -> f64 {
+        4.0 * std::f64::consts::PI
+    }
+
+    fn level(&self, tile: &SphereTile) -> u32 {
+        tile.level as u32
+    }
+
+    fn max_level(&self) -> u32 {
+        MAX_LEVEL
+    }
+
+    fn capacity(&self, level: u32) -> f64 {
+        ROOT_COUNT as f64 * 4f64.powi(level as i32)
+    }
+
+    fn code(&self, tile: &SphereTile) -> u64 {
+        tile.code
+    }
+
+    fn region(&self, tile: &SphereTile) -> SphereRegion {
+        let centroid = self.shape.centroid();
+        let cell = |i: usize| {
+            let (cx, cy) = self.shape.cells()[i];
+            let p = self.face_point(tile, [cx as f64 + 0.5, cy as f64 + 0.5]);
+            [p.x, p.y]
+        };
+        let nside = Self::nside(tile.level as u32) as f64;
+        SphereRegion {
+            center: self.face_point(tile, centroid).to_vec(),
+            radius: FACE_LIPSCHITZ * PENTOMINO_RADIUS / nside,
+            face: tile.face,
+            cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
+        }
+    }
+
+    fn sample(&self, tile: &SphereTile, fraction: f64) -> DVec3 {
+        self.face_point(tile, self.offset(tile, fraction)).to_vec()
+    }
+}

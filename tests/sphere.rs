@@ -1,0 +1,243 @@
+//! The sphere tile system and sampler: geometry, codes, counts, determinism.
+
+use approx::assert_relative_eq;
+use glam::DVec3;
+use proptest::prelude::*;
+use std::collections::HashSet;
+use std::f64::consts::PI;
+use tessera::density::sphere::{angle_between, Cap};
+use tessera::density::Uniform;
+use tessera::healpix::FacePoint;
+use tessera::tiling::polyomino::{Rule, Shape};
+use tessera::tiling::sphere::{SphereTile, SphereTiling, FACE_LIPSCHITZ};
+use tessera::tiling::TileSystem;
+use tessera::{engine, Sampler};
+
+fn tiles_at(tiling: &SphereTiling, level: u32) -> Vec<SphereTile> {
+    let mut tiles = tiling.roots();
+    for _ in 0..level {
+        tiles = tiles
+            .iter()
+            .flat_map(|t| (0..4).map(move |c| tiling.child(t, c)))
+            .collect();
+    }
+    tiles
+}
+
+#[test]
+fn the_p_pentomino_has_exactly_two_dissections_and_both_tile_the_parent() {
+    let rules = Rule::p_pentomino_rules();
+    assert_eq!(rules.len(), 2);
+    for rule in &rules {
+        assert!(rule.tiles_parent(&Shape::p_pentomino()));
+    }
+    // the shipped table uses exactly these rules
+    assert_eq!(SphereTiling::default().lut().rules, rules);
+}
+
+#[test]
+fn every_level_partitions_the_healpix_cells_into_pentominoes() {
+    let tiling = SphereTiling::default();
+    for level in 0..=3u32 {
+        let tiles = tiles_at(&tiling, level);
+        assert_eq!(tiles.len(), 240 << (2 * level));
+        let nside = SphereTiling::nside(level) as i32;
+        let mut cells = HashSet::new();
+        for t in &tiles {
+            for (i, j) in t.placement.cells(tiling.shape()) {
+                assert!(
+                    (0..nside).contains(&i) && (0..nside).contains(&j),
+                    "cell off its face"
+                );
+                assert!(cells.insert((t.face, i, j)), "two tiles share a cell");
+            }
+        }
+        assert_eq!(cells.len(), 12 * (nside * nside) as usize);
+        // equal-area cells: the tiles' areas add up to the sphere's
+        let cell_area = 4.0 * PI / (12.0 * (nside as f64).powi(2));
+        let total: f64 = tiles.iter().map(|_| 5.0 * cell_area).sum();
+        assert_relative_eq!(total, 4.0 * PI, max_relative = 1e-12);
+    }
+}
+
+#[test]
+fn codes_of_a_level_are_a_permutation() {
+    let tiling = SphereTiling::default();
+    for level in 0..=3u32 {
+        let mut codes: Vec<u64> = tiles_at(&tiling, level).iter().map(|t| t.code).collect();
+        codes.sort_unstable();
+        assert!(
+            codes.iter().enumerate().all(|(i, &c)| c == i as u64),
+            "level {level}"
+        );
+    }
+}
+
+#[test]
+fn bounding_caps_contain_their_tiles() {
+    let tiling = SphereTiling::default();
+    let shape = Shape::p_pentomino();
+    let mut worst: f64 = 0.0;
+    for level in [0u32, 1, 3] {
+        for (n, t) in tiles_at(&tiling, level).iter().enumerate() {
+            if level == 3 && n % 7 != 0 {
+                continue;
+            }
+            let region = tiling.region(t);
+            for &(cx, cy) in shape.cells() {
+                for a in 0..=4 {
+                    for b in 0..=4 {
+                        let local = [cx as f64 + a as f64 / 4.0, cy as f64 + b as f64 / 4.0];
+                        let p = tiling.face_point(t, local).to_vec();
+                        let d = angle_between(p, region.center);
+                        worst = worst.max(d / region.radius);
+                        assert!(d <= region.radius, "tile point outside its cap");
+                    }
+                }
+            }
+        }
+    }
+    // the Lipschitz constant is not wildly loose either
+    assert!(worst > 0.5 && FACE_LIPSCHITZ < 2.0, "worst ratio {worst}");
+}
+
+#[test]
+fn full_levels_put_one_point_in_each_pentomino() {
+    let tiling = SphereTiling::default();
+    for level in 0..=3u32 {
+        let n = 240usize << (2 * level);
+        let samples = engine::generate(&tiling, &Uniform, n, true).unwrap();
+        assert_eq!(samples.len(), n);
+        let nside = SphereTiling::nside(level);
+        let mut per_face = [0usize; 12];
+        let mut cells = HashSet::new();
+        for s in &samples {
+            let fp = FacePoint::from_vec(s.position);
+            per_face[fp.face as usize] += 1;
+            let cell = (
+                fp.face,
+                ((fp.x * nside as f64) as i64).min(nside - 1),
+                ((fp.y * nside as f64) as i64).min(nside - 1),
+            );
+            assert!(
+                cells.insert(cell),
+                "two points in one HEALPix cell at level {level}"
+            );
+        }
+        assert!(per_face.iter().all(|&c| c == n / 12), "{per_face:?}");
+        // each point inside its own tile
+        for t in tiles_at(&tiling, level) {
+            let offset = tiling.offset(&t, 1.0);
+            assert!(tiling.shape().contains(offset));
+        }
+    }
+}
+
+#[test]
+fn output_is_deterministic_and_independent_of_threads() {
+    let cap = Cap::new(30.0, 10.0, 25.0, 40.0).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            Sampler::sphere()
+                .density(cap)
+                .count(5000)
+                .generate()
+                .unwrap()
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(1));
+}
+
+#[test]
+fn every_prefix_is_a_progressive_subset() {
+    let samples = Sampler::sphere().count(3072).generate().unwrap();
+    let nearest = |pts: &[DVec3]| {
+        let mut best = f64::INFINITY;
+        for (i, a) in pts.iter().enumerate() {
+            for b in &pts[i + 1..] {
+                best = best.min(angle_between(*a, *b));
+            }
+        }
+        best * (pts.len() as f64).sqrt()
+    };
+    let points: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
+    let full = nearest(&points);
+    for prefix in [100, 500, 1500] {
+        let sep = nearest(&points[..prefix]);
+        assert!(sep > 0.5 * full, "prefix {prefix}: {sep} vs {full}");
+    }
+}
+
+#[test]
+fn cap_with_contrast_100_gets_its_share_within_two_percent() {
+    for (lon, lat) in [(0.0, 90.0), (45.0, 0.0), (-120.0, -41.8)] {
+        let cap = Cap::new(lon, lat, 15.0, 100.0).unwrap();
+        let n = 20000;
+        let samples = Sampler::sphere().density(cap).count(n).generate().unwrap();
+        assert_eq!(samples.len(), n);
+        let inside = samples.iter().filter(|s| cap.contains(s.position)).count() as f64 / n as f64;
+        let expected = cap.mass_fraction();
+        assert!(
+            (inside - expected).abs() <= 0.02 * expected,
+            "cap at ({lon},{lat}): {inside} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn small_bright_caps_are_never_skipped() {
+    // a cap far smaller than a root tile, 1e6 times brighter
+    let cap = Cap::new(10.0, 20.0, 0.05, 1e6).unwrap();
+    let samples = Sampler::sphere()
+        .density(cap)
+        .count(2000)
+        .generate()
+        .unwrap();
+    let inside = samples.iter().filter(|s| cap.contains(s.position)).count() as f64;
+    let expected = cap.mass_fraction() * 2000.0;
+    assert!(expected > 100.0);
+    assert!(
+        (inside - expected).abs() < 0.05 * expected + 3.0,
+        "{inside} vs {expected}"
+    );
+}
+
+#[test]
+fn counts_are_exact_for_awkward_n() {
+    for n in [0usize, 1, 2, 3, 239, 241, 1001, 4097] {
+        assert_eq!(Sampler::sphere().count(n).generate().unwrap().len(), n);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #[test]
+    fn random_caps_follow_their_density(
+        lon in -180.0f64..180.0,
+        lat in -90.0f64..90.0,
+        radius in 5.0f64..60.0,
+        contrast in 0.0f64..50.0,
+        n in 500usize..3000,
+    ) {
+        let cap = Cap::new(lon, lat, radius, contrast).unwrap();
+        let samples = Sampler::sphere().density(cap).count(n).generate().unwrap();
+        prop_assert_eq!(samples.len(), n);
+        for s in &samples {
+            prop_assert!(s.position.is_finite());
+            prop_assert!((s.position.length() - 1.0).abs() < 1e-12);
+        }
+        let inside = samples.iter().filter(|s| cap.contains(s.position)).count() as f64;
+        let expected = cap.mass_fraction() * n as f64;
+        // blue-noise sets beat Poisson counting noise; the cap's rim is
+        // resolved to about one tile, so allow a rim term too
+        let rim_tiles = 2.0 * PI * radius.to_radians().sin() / (4.0 * PI / n as f64).sqrt();
+        prop_assert!((inside - expected).abs() <= 4.0 * expected.sqrt() + 0.5 * rim_tiles + 2.0,
+            "inside {} expected {}", inside, expected);
+    }
+}
