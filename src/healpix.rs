@@ -1,1 +1,612 @@
-//! placeholder
+//! The HEALPix equal-area mapping between the unit sphere and twelve unit squares.
+//!
+//! The sphere is cut into [`FACE_COUNT`] = 12 base faces (the HEALPix base pixels): four
+//! around the north pole (faces `0..4`), four on the equator (`4..8`) and four around the
+//! south pole (`8..12`). Each face is parameterised by face-local coordinates
+//! `(x, y)` in `[0, 1]^2`, with the convention of HEALPix NESTED indexing: `(x, y)` is the
+//! continuous `(ix, iy) / nside` inside the base pixel, i.e. the same as
+//! `cdshealpix::nested::hash_with_dxdy` at depth 0 (`hash` = face, `dx` = x, `dy` = y).
+//!
+//! * `(0, 0)` is the face's south vertex, `(1, 1)` its north vertex;
+//! * `x` points north-east (increasing longitude and latitude);
+//! * `y` points north-west;
+//! * the frame `(x, y)` is counter-clockwise when seen from outside the sphere.
+//!
+//! The mapping is equal-area: every face covers `4 pi / 12` steradians and the Jacobian of
+//! `(x, y) -> sphere` is the constant `pi / 3` everywhere (except on the measure-zero set
+//! where it is not differentiable).
+//!
+//! # Numerical notes
+//!
+//! All computations are in `f64` and avoid the classical cancellations:
+//!
+//! * near the poles `sin(theta)` is never computed as `sqrt(1 - z^2)`; inside the polar caps
+//!   `1 - |z| = sigma^2 / 3` exactly, so `sin(theta) = sigma * sqrt((1 + |z|) / 3)`, and the
+//!   inverse uses `sqrt(3 (1 - |z|)) = sin(theta) * sqrt(3 / (1 + |z|))`;
+//! * longitudes are handled inside the current quarter of the sphere: the vector is rotated
+//!   by an exact multiple of `pi / 2` (sign swaps) before `atan2`, so the in-quadrant
+//!   longitude keeps full relative precision;
+//! * [`FacePoint::from_angles`] never casts a longitude to an integer: it goes through
+//!   `sin_cos`, whose argument reduction is exact, so even `phi = -1e12` gives the correctly
+//!   reduced direction (a `rem_euclid(TAU)` would be off by about `phi * 2.4e-16 / TAU`
+//!   radians because `TAU` is not exactly `2 pi`).
+//!
+//! Round trips `FacePoint -> DVec3 -> FacePoint` are accurate to a few `f64::EPSILON`
+//! in absolute terms everywhere, including at and next to the poles and seams.
+//!
+//! # Invalid input
+//!
+//! No function of this module panics on any input. Face numbers `>= 12` are taken modulo 12
+//! and face coordinates are clamped into `[0, 1]`. NaN coordinates propagate (a NaN
+//! [`FacePoint`] maps to a NaN vector); a zero, infinite or NaN vector, or a non-finite angle,
+//! gives [`FacePoint::INVALID`] (face 0, NaN coordinates).
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_2_PI, FRAC_PI_2, FRAC_PI_4, TAU};
+
+/// The number of HEALPix base faces.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::FACE_COUNT;
+/// assert_eq!(FACE_COUNT, 12);
+/// ```
+pub const FACE_COUNT: usize = 12;
+
+/// `|z|` of the boundary between the equatorial belt and the polar caps (`2 / 3`).
+const Z_SEAM: f64 = 2.0 / 3.0;
+
+/// A point on the sphere given by its base face and face-local coordinates.
+///
+/// `face` is in `0..12`; `x` and `y` are in `[0, 1]` (see the [module docs](self) for the
+/// orientation). Points on face edges have several valid representations.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::FacePoint;
+/// // The centre of equatorial face 4 is (lon, lat) = (0, 0).
+/// let v = FacePoint::new(4, 0.5, 0.5).to_vec();
+/// assert!((v - glam::DVec3::X).length() < 1e-15);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FacePoint {
+    /// Base face, in `0..12`.
+    pub face: u8,
+    /// North-east coordinate, in `[0, 1]`.
+    pub x: f64,
+    /// North-west coordinate, in `[0, 1]`.
+    pub y: f64,
+}
+
+impl FacePoint {
+    /// The value returned for invalid input (zero or non-finite vectors, non-finite angles):
+    /// face 0 with NaN coordinates.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::from_vec(glam::DVec3::ZERO);
+    /// assert!(p.x.is_nan() && p.y.is_nan());
+    /// ```
+    pub const INVALID: FacePoint = FacePoint {
+        face: 0,
+        x: f64::NAN,
+        y: f64::NAN,
+    };
+
+    /// Creates a face point; no validation is done here (see [`FacePoint::to_vec`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::new(3, 0.25, 0.75);
+    /// assert_eq!((p.face, p.x, p.y), (3, 0.25, 0.75));
+    /// ```
+    #[inline]
+    pub const fn new(face: u8, x: f64, y: f64) -> Self {
+        FacePoint { face, x, y }
+    }
+
+    /// Maps the face point to a unit vector.
+    ///
+    /// The face is taken modulo 12 and `x`, `y` are clamped into `[0, 1]`; NaN coordinates
+    /// give a NaN vector.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// // The north vertex of any north face is the north pole.
+    /// assert_eq!(FacePoint::new(2, 1.0, 1.0).to_vec(), glam::DVec3::Z);
+    /// // The south vertex of a south face is the south pole.
+    /// assert_eq!(FacePoint::new(9, 0.0, 0.0).to_vec(), -glam::DVec3::Z);
+    /// ```
+    pub fn to_vec(self) -> DVec3 {
+        let face = self.face % FACE_COUNT as u8;
+        let x = self.x.clamp(0.0, 1.0);
+        let y = self.y.clamp(0.0, 1.0);
+        // (z, sin(theta), longitude inside the quadrant starting at k pi / 2)
+        let (z, sin_theta, a) = match face / 4 {
+            0 => {
+                let sigma = (1.0 - x) + (1.0 - y);
+                if sigma >= 1.0 {
+                    equatorial_zone(x + y, FRAC_PI_4 * (1.0 + (x - y)))
+                } else if sigma > 0.0 {
+                    let one_minus_z = sigma * sigma / 3.0;
+                    let z = 1.0 - one_minus_z;
+                    let sin_theta = sigma * ((1.0 + z) / 3.0).sqrt();
+                    (z, sin_theta, FRAC_PI_2 * ((1.0 - y) / sigma))
+                } else if sigma == 0.0 {
+                    return DVec3::Z;
+                } else {
+                    return DVec3::NAN;
+                }
+            }
+            1 => equatorial_zone(x + y - 1.0, FRAC_PI_4 * (x - y)),
+            _ => {
+                let sigma = x + y;
+                if sigma >= 1.0 {
+                    equatorial_zone(sigma - 2.0, FRAC_PI_4 * (1.0 + (x - y)))
+                } else if sigma > 0.0 {
+                    let one_minus_abs_z = sigma * sigma / 3.0;
+                    let abs_z = 1.0 - one_minus_abs_z;
+                    let sin_theta = sigma * ((1.0 + abs_z) / 3.0).sqrt();
+                    (-abs_z, sin_theta, FRAC_PI_2 * (x / sigma))
+                } else if sigma == 0.0 {
+                    return DVec3::NEG_Z;
+                } else {
+                    return DVec3::NAN;
+                }
+            }
+        };
+        let (s, c) = a.sin_cos();
+        let (cx, cy) = rotate_quarter_turns(c, s, face % 4);
+        DVec3::new(sin_theta * cx, sin_theta * cy, z)
+    }
+
+    /// Maps a direction to its face point. `v` need not be normalised but must be non-zero and
+    /// finite; otherwise [`FacePoint::INVALID`] is returned.
+    ///
+    /// Points on face edges are assigned to one of the adjacent faces.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::from_vec(glam::DVec3::new(2.0, 0.0, 0.0));
+    /// assert_eq!(p.face, 4);
+    /// assert!((p.x - 0.5).abs() < 1e-15 && (p.y - 0.5).abs() < 1e-15);
+    /// ```
+    pub fn from_vec(v: DVec3) -> Self {
+        if !v.is_finite() {
+            return Self::INVALID;
+        }
+        let m = v.abs().max_element();
+        if m == 0.0 {
+            return Self::INVALID;
+        }
+        // Rescale by an exact power of two when squaring could overflow or underflow.
+        let v = if (1e-150..=1e150).contains(&m) {
+            v
+        } else {
+            v * pow2(-exponent(m))
+        };
+        let rho2 = v.x * v.x + v.y * v.y;
+        let r = (rho2 + v.z * v.z).sqrt();
+        let z = (v.z / r).clamp(-1.0, 1.0);
+        let sin_theta = rho2.sqrt() / r;
+        from_parts(v.x, v.y, z, sin_theta)
+    }
+
+    /// Colatitude and longitude `(theta, phi)` of the face point, `theta` in `[0, pi]`,
+    /// `phi` in `[0, 2 pi)`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let (theta, phi) = FacePoint::new(0, 1.0, 1.0).to_angles();
+    /// assert_eq!((theta, phi), (0.0, 0.0));
+    /// ```
+    pub fn to_angles(self) -> (f64, f64) {
+        vec_to_angles(self.to_vec())
+    }
+
+    /// Face point of the colatitude `theta` and longitude `phi` (radians, any finite values:
+    /// the direction is that of [`angles_to_vec`]). Non-finite angles give
+    /// [`FacePoint::INVALID`].
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::from_angles(std::f64::consts::FRAC_PI_2, 0.0);
+    /// assert_eq!(p.face, 4);
+    /// assert!((p.x - 0.5).abs() < 1e-15 && (p.y - 0.5).abs() < 1e-15);
+    /// ```
+    pub fn from_angles(theta: f64, phi: f64) -> Self {
+        if !(theta.is_finite() && phi.is_finite()) {
+            return Self::INVALID;
+        }
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        from_parts(st * cp, st * sp, ct, st.abs())
+    }
+}
+
+/// `(z, sin(theta), a)` in the equatorial zone, from `Y = 3 z / 2` and the in-quadrant
+/// longitude `a`.
+#[inline]
+fn equatorial_zone(y_proj: f64, a: f64) -> (f64, f64, f64) {
+    let z = 2.0 * y_proj / 3.0;
+    (z, ((1.0 - z) * (1.0 + z)).sqrt(), a)
+}
+
+/// Rotates `(c, s)` counter-clockwise by `k` quarter turns (exactly).
+#[inline]
+fn rotate_quarter_turns(c: f64, s: f64, k: u8) -> (f64, f64) {
+    match k & 3 {
+        0 => (c, s),
+        1 => (-s, c),
+        2 => (-c, -s),
+        _ => (s, -c),
+    }
+}
+
+/// Splits the longitude of the direction `(cx, cy)` into a quadrant `q` in `0..4` and the
+/// fraction `u` in `[0, 1)` of the quadrant: `phi = (q + u) pi / 2`.
+/// The zero direction (a pole) gives `(0, 0)`.
+#[inline]
+fn quadrant(cx: f64, cy: f64) -> (u8, f64) {
+    // Rotate by -q pi / 2 exactly so that the direction lies in the first quadrant.
+    let (q, a, b) = if cx > 0.0 && cy >= 0.0 {
+        (0, cx, cy)
+    } else if cx <= 0.0 && cy > 0.0 {
+        (1, cy, -cx)
+    } else if cx < 0.0 && cy <= 0.0 {
+        (2, -cx, -cy)
+    } else if cx >= 0.0 && cy < 0.0 {
+        (3, -cy, cx)
+    } else {
+        return (0, 0.0);
+    };
+    let u = b.atan2(a) * FRAC_2_PI;
+    if u >= 1.0 {
+        ((q + 1) & 3, 0.0)
+    } else {
+        // `max` also turns -0.0 into +0.0.
+        (q, u.max(0.0))
+    }
+}
+
+/// The forward mapping from `(cx, cy)` (direction of the longitude, any positive scale),
+/// `z = cos(theta)` and `sin_theta = sin(theta) >= 0`.
+fn from_parts(cx: f64, cy: f64, z: f64, sin_theta: f64) -> FacePoint {
+    let (q, u) = quadrant(cx, cy);
+    if z.abs() <= Z_SEAM {
+        let t = 0.75 * z;
+        // jp, jm in [0, 2) since u in [0, 1) and |t| <= 1/2.
+        let jp = 0.5 + u - t;
+        let jm = 0.5 + u + t;
+        let fp = jp.floor();
+        let fm = jm.floor();
+        let x = (jm - fm).clamp(0.0, 1.0);
+        let y = (1.0 - (jp - fp)).clamp(0.0, 1.0);
+        let face = if fp == fm {
+            4 + ((q + fp as u8) & 3)
+        } else if fp < fm {
+            (q + fp as u8) & 3
+        } else {
+            8 + ((q + fm as u8) & 3)
+        };
+        FacePoint { face, x, y }
+    } else {
+        // s = sqrt(3 (1 - |z|)) in [0, 1], computed without cancellation.
+        let s = (sin_theta * (3.0 / (1.0 + z.abs())).sqrt()).min(1.0);
+        let jp = (u * s).min(1.0);
+        let jm = ((1.0 - u) * s).min(1.0);
+        if z > 0.0 {
+            FacePoint {
+                face: q,
+                x: 1.0 - jm,
+                y: 1.0 - jp,
+            }
+        } else {
+            FacePoint {
+                face: q + 8,
+                x: jp,
+                y: jm,
+            }
+        }
+    }
+}
+
+/// Unbiased binary exponent of a positive finite `m` (subnormals give -1023).
+#[inline]
+fn exponent(m: f64) -> i32 {
+    ((m.to_bits() >> 52) & 0x7ff) as i32 - 1023
+}
+
+/// `2^e` for `e` in `-1074..=1023`, exactly.
+#[inline]
+fn pow2(e: i32) -> f64 {
+    if e >= -1022 {
+        f64::from_bits(((e + 1023) as u64) << 52)
+    } else {
+        f64::from_bits(1u64 << (e + 1074))
+    }
+}
+
+/// Unit vector of colatitude `theta` and longitude `phi` (radians).
+///
+/// # Example
+/// ```
+/// use tessera::healpix::angles_to_vec;
+/// let v = angles_to_vec(std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2);
+/// assert!((v - glam::DVec3::Y).length() < 1e-15);
+/// ```
+#[inline]
+pub fn angles_to_vec(theta: f64, phi: f64) -> DVec3 {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    DVec3::new(st * cp, st * sp, ct)
+}
+
+/// Colatitude `theta` in `[0, pi]` and longitude `phi` in `[0, 2 pi)` of a (not necessarily
+/// normalised) vector. `theta` is computed as `atan2(hypot(x, y), z)`, accurate at the poles.
+/// The zero vector gives `(0, 0)`; NaN components give NaN angles.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::vec_to_angles;
+/// let (theta, phi) = vec_to_angles(glam::DVec3::new(0.0, -1.0, 0.0));
+/// assert!((theta - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+/// assert!((phi - 1.5 * std::f64::consts::PI).abs() < 1e-15);
+/// ```
+pub fn vec_to_angles(v: DVec3) -> (f64, f64) {
+    let theta = v.x.hypot(v.y).atan2(v.z);
+    let mut phi = v.y.atan2(v.x);
+    if phi < 0.0 {
+        phi += TAU;
+    }
+    if phi >= TAU {
+        // -tiny + TAU rounds to TAU: the closest representable in-range angle is 0.
+        phi = 0.0;
+    }
+    // `+ 0.0` turns -0.0 into +0.0.
+    (theta, phi + 0.0)
+}
+
+/// Longitude in `[-180, 180)` and latitude in `[-90, 90]`, in degrees, of a (not necessarily
+/// normalised) vector.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::lonlat_deg;
+/// let (lon, lat) = lonlat_deg(glam::DVec3::new(-1.0, 0.0, 1.0));
+/// assert_eq!(lon, -180.0);
+/// assert!((lat - 45.0).abs() < 1e-12);
+/// ```
+pub fn lonlat_deg(v: DVec3) -> (f64, f64) {
+    let mut lon = v.y.atan2(v.x).to_degrees();
+    if lon >= 180.0 {
+        lon -= 360.0;
+    }
+    let lat = v.z.atan2(v.x.hypot(v.y)).to_degrees().clamp(-90.0, 90.0);
+    (lon + 0.0, lat)
+}
+
+/// Centre of cell `(i, j)` of face `face` at resolution `nside`: the image of the face point
+/// `((i + 0.5) / nside, (j + 0.5) / nside)`.
+///
+/// `i` and `j` should be in `0..nside` (out-of-range values are clamped to the face).
+///
+/// # Example
+/// ```
+/// use tessera::healpix::{cell_center, FacePoint};
+/// assert_eq!(cell_center(5, 1, 0, 0), FacePoint::new(5, 0.5, 0.5).to_vec());
+/// ```
+pub fn cell_center(face: u8, nside: u64, i: u64, j: u64) -> DVec3 {
+    let n = nside as f64;
+    FacePoint::new(face, (i as f64 + 0.5) / n, (j as f64 + 0.5) / n).to_vec()
+}
+
+/// A cell `(i, j)` of a face at some resolution `nside` (given separately), with
+/// `0 <= i, j < nside`; `i` runs along `x`, `j` along `y`.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::Cell;
+/// let c = Cell { face: 7, i: 3, j: 0 };
+/// assert_eq!(c.i, 3);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Cell {
+    /// Base face, in `0..12`.
+    pub face: u8,
+    /// Index along the face's `x` axis, in `0..nside`.
+    pub i: i64,
+    /// Index along the face's `y` axis, in `0..nside`.
+    pub j: i64,
+}
+
+/// One of the four edge directions of the face-local frame, in counter-clockwise order.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::Dir;
+/// assert_eq!(Dir::PlusX.rotate_ccw(1), Dir::PlusY);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Dir {
+    /// Towards increasing `x` (north-east).
+    PlusX = 0,
+    /// Towards increasing `y` (north-west).
+    PlusY = 1,
+    /// Towards decreasing `x` (south-west).
+    MinusX = 2,
+    /// Towards decreasing `y` (south-east).
+    MinusY = 3,
+}
+
+impl Dir {
+    /// The four directions, in counter-clockwise order.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// assert_eq!(Dir::ALL[2], Dir::MinusX);
+    /// ```
+    pub const ALL: [Dir; 4] = [Dir::PlusX, Dir::PlusY, Dir::MinusX, Dir::MinusY];
+
+    /// Index in counter-clockwise order (`PlusX` = 0, ..., `MinusY` = 3).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// assert_eq!(Dir::MinusY.index(), 3);
+    /// ```
+    #[inline]
+    pub const fn index(self) -> u8 {
+        self as u8
+    }
+
+    /// The direction of index `i % 4`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// assert_eq!(Dir::from_index(5), Dir::PlusY);
+    /// ```
+    #[inline]
+    pub const fn from_index(i: u8) -> Dir {
+        match i & 3 {
+            0 => Dir::PlusX,
+            1 => Dir::PlusY,
+            2 => Dir::MinusX,
+            _ => Dir::MinusY,
+        }
+    }
+
+    /// The opposite direction.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// assert_eq!(Dir::PlusY.opposite(), Dir::MinusY);
+    /// ```
+    #[inline]
+    pub const fn opposite(self) -> Dir {
+        Dir::from_index(self.index() + 2)
+    }
+
+    /// The direction rotated counter-clockwise by `quarter_turns` quarter turns.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// assert_eq!(Dir::MinusY.rotate_ccw(1), Dir::PlusX);
+    /// ```
+    #[inline]
+    pub const fn rotate_ccw(self, quarter_turns: u8) -> Dir {
+        Dir::from_index(self.index() + (quarter_turns & 3))
+    }
+
+    /// The same geometric direction expressed in a frame that is rotated counter-clockwise by
+    /// `turns` quarter turns, e.g. the `turns` returned by [`step`]: after
+    /// `let (next, turns) = step(cell, nside, dir)`, going on straight is
+    /// `dir.reframe(turns)` and going back is `dir.reframe(turns).opposite()`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::Dir;
+    /// // In a frame rotated by a quarter turn ccw, the old +x axis is the new -y axis.
+    /// assert_eq!(Dir::PlusX.reframe(1), Dir::MinusY);
+    /// ```
+    #[inline]
+    pub const fn reframe(self, turns: u8) -> Dir {
+        Dir::from_index(self.index() + 4 - (turns & 3))
+    }
+}
+
+/// The edge-neighbour of `cell` in direction `dir` at resolution `nside`, and the number of
+/// quarter turns `turns` in `0..4` by which the local frame rotates counter-clockwise (seen
+/// from outside the sphere) when crossing into the neighbour's face: the new face's axes are
+/// the old ones rotated by `turns` quarter turns (see [`Dir::reframe`]).
+///
+/// `turns` is 0 inside a face and across all seams except those between two polar faces of
+/// the same cap (1 or 3 there). The face gluing, in face coordinates with `k` taken modulo 4:
+///
+/// * north `k`: `(1, t)` = north `k+1`: `(t, 1)`;
+/// * north `k`: `(0, t)` = equatorial `4+k`: `(1, t)`;
+/// * north `k`: `(t, 0)` = equatorial `4+(k+1)`: `(t, 1)`;
+/// * equatorial `4+k`: `(0, t)` = south `8+(k-1)`: `(1, t)`;
+/// * equatorial `4+k`: `(t, 0)` = south `8+k`: `(t, 1)`;
+/// * south `8+k`: `(0, t)` = south `8+(k-1)`: `(t, 0)`.
+///
+/// `cell` must satisfy `0 <= i, j < nside` (out-of-range input gives an unspecified cell but
+/// does not panic).
+///
+/// # Example
+/// ```
+/// use tessera::healpix::{step, Cell, Dir};
+/// // Leaving north face 0 through its x = 1 edge enters north face 1 through its y = 1 edge.
+/// let (next, turns) = step(Cell { face: 0, i: 3, j: 1 }, 4, Dir::PlusX);
+/// assert_eq!((next, turns), (Cell { face: 1, i: 1, j: 3 }, 1));
+/// // Stepping back:
+/// let back = Dir::PlusX.reframe(turns).opposite();
+/// assert_eq!(step(next, 4, back).0, Cell { face: 0, i: 3, j: 1 });
+/// ```
+pub fn step(cell: Cell, nside: i64, dir: Dir) -> (Cell, u8) {
+    let Cell { face, i, j } = cell;
+    let (ni, nj) = match dir {
+        Dir::PlusX => (i.saturating_add(1), j),
+        Dir::PlusY => (i, j.saturating_add(1)),
+        Dir::MinusX => (i.saturating_sub(1), j),
+        Dir::MinusY => (i, j.saturating_sub(1)),
+    };
+    if (0..nside).contains(&ni) && (0..nside).contains(&nj) {
+        return (Cell { face, i: ni, j: nj }, 0);
+    }
+    let last = nside.saturating_sub(1);
+    let face = face % FACE_COUNT as u8;
+    let k = face & 3;
+    let next = (k + 1) & 3;
+    let prev = (k + 3) & 3;
+    let cell = |face: u8, i: i64, j: i64| Cell { face, i, j };
+    match (face / 4, dir) {
+        // North faces.
+        (0, Dir::PlusX) => (cell(next, j, last), 1),
+        (0, Dir::PlusY) => (cell(prev, last, i), 3),
+        (0, Dir::MinusX) => (cell(4 + k, last, j), 0),
+        (0, Dir::MinusY) => (cell(4 + next, i, last), 0),
+        // Equatorial faces.
+        (1, Dir::PlusX) => (cell(k, 0, j), 0),
+        (1, Dir::PlusY) => (cell(prev, i, 0), 0),
+        (1, Dir::MinusX) => (cell(8 + prev, last, j), 0),
+        (1, Dir::MinusY) => (cell(8 + k, i, last), 0),
+        // South faces.
+        (_, Dir::PlusX) => (cell(4 + next, 0, j), 0),
+        (_, Dir::PlusY) => (cell(4 + k, i, 0), 0),
+        (_, Dir::MinusX) => (cell(8 + prev, j, 0), 1),
+        (_, Dir::MinusY) => (cell(8 + next, 0, i), 3),
+    }
+}
+
+/// Whether the given corner of a face is one of the 8 vertices shared by only three faces
+/// (instead of four): the east and west vertices of the polar faces, which are the north and
+/// south vertices of the equatorial faces, at `z = +-2/3` and `phi = k pi / 2`.
+///
+/// `corner` is `(x == 1, y == 1)`, e.g. `(false, false)` is the south vertex `(0, 0)`.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::is_three_face_corner;
+/// assert!(is_three_face_corner(0, (true, false))); // east vertex of north face 0
+/// assert!(!is_three_face_corner(0, (true, true))); // the north pole (four faces)
+/// assert!(is_three_face_corner(5, (true, true))); // north vertex of equatorial face 5
+/// ```
+pub fn is_three_face_corner(face: u8, corner: (bool, bool)) -> bool {
+    let mixed = corner.0 != corner.1;
+    match (face % FACE_COUNT as u8) / 4 {
+        1 => !mixed,
+        _ => mixed,
+    }
+}
