@@ -1,0 +1,489 @@
+//! Metrics for point sets in the unit square `[0, 1)²`.
+//!
+//! Distances are plain Euclidean inside the square (no toroidal wrapping).
+//! Nearest-neighbour distances are normalised by the spacing of the
+//! hexagonal lattice with the same density, `d_hex = √(2 / (√3 N))`.
+//!
+//! | function | cost | empty input | one point |
+//! | --- | --- | --- | --- |
+//! | [`min_distance`], [`mean_nn_distance`] | O(N log N) | NaN | +∞ |
+//! | [`l2_star_discrepancy`], [`centered_l2_discrepancy`] | O(N²/2), parallel | NaN | closed form |
+//! | [`periodogram`] | O(N size²), parallel | NaN grid | all 1 |
+//! | [`radial_average`], [`anisotropy`] | O(size²) | | |
+//! | [`low_frequency_power`] | O(N²) (size ≈ √N), parallel | NaN | NaN |
+//!
+//! ```
+//! use tessera::baselines::{jittered_grid_2d, uniform_random_2d};
+//! use tessera::metrics::plane::{l2_star_discrepancy, low_frequency_power};
+//! let (jit, rnd) = (jittered_grid_2d(32, 1), uniform_random_2d(1024, 1));
+//! assert!(l2_star_discrepancy(&jit) < l2_star_discrepancy(&rnd));
+//! assert!(low_frequency_power(&jit) < low_frequency_power(&rnd));
+//! ```
+
+use super::Dd;
+use glam::DVec2;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::f64::consts::TAU;
+use std::num::NonZero;
+
+/// Spacing of the hexagonal lattice with N points per unit area,
+/// `√(2 / (√3 N))`, the normalisation of [`min_distance`] and
+/// [`mean_nn_distance`].
+///
+/// ```
+/// use tessera::metrics::plane::hex_spacing;
+/// // A unit-area rhombus cell of side d has area (√3/2) d².
+/// let d = hex_spacing(100);
+/// assert!((100.0 * 3f64.sqrt() / 2.0 * d * d - 1.0).abs() < 1e-12);
+/// ```
+pub fn hex_spacing(n: usize) -> f64 {
+    (2.0 / (3f64.sqrt() * n as f64)).sqrt()
+}
+
+/// Euclidean distance from each point to its nearest other point (N ≥ 2).
+fn nn_distances(points: &[DVec2]) -> Vec<f64> {
+    let coords: Vec<[f64; 2]> = points.iter().map(|p| p.to_array()).collect();
+    let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&coords);
+    (0..points.len())
+        .into_par_iter()
+        .map(|i| {
+            let found = tree.nearest_n::<SquaredEuclidean>(&coords[i], NonZero::new(2).unwrap());
+            let j = found
+                .iter()
+                .map(|nn| nn.item as usize)
+                .find(|&j| j != i)
+                .expect("a tree of at least two points returns another point");
+            points[i].distance(points[j])
+        })
+        .collect()
+}
+
+/// Minimum pairwise distance divided by [`hex_spacing`]`(N)` (1 for a
+/// hexagonal lattice of the same density, about 0.75–0.85 for good blue
+/// noise). Nearest neighbours by k-d tree, cost O(N log N). Returns NaN for
+/// an empty set and +∞ for a single point; coincident points give 0.
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::{hex_spacing, min_distance};
+/// let pts = [DVec2::new(0.25, 0.5), DVec2::new(0.75, 0.5)];
+/// assert!((min_distance(&pts) - 0.5 / hex_spacing(2)).abs() < 1e-15);
+/// ```
+pub fn min_distance(points: &[DVec2]) -> f64 {
+    match points.len() {
+        0 => f64::NAN,
+        1 => f64::INFINITY,
+        n => {
+            nn_distances(points)
+                .into_iter()
+                .fold(f64::INFINITY, f64::min)
+                / hex_spacing(n)
+        }
+    }
+}
+
+/// Mean nearest-neighbour distance divided by [`hex_spacing`]`(N)` (1 for a
+/// hexagonal lattice, about 0.465 for uniform random points away from the
+/// border). Cost O(N log N). Returns NaN for an empty set and +∞ for a single
+/// point.
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::mean_nn_distance;
+/// let m = mean_nn_distance(&uniform_random_2d(4000, 1));
+/// assert!(m > 0.43 && m < 0.50);
+/// ```
+pub fn mean_nn_distance(points: &[DVec2]) -> f64 {
+    match points.len() {
+        0 => f64::NAN,
+        1 => f64::INFINITY,
+        n => {
+            let mut acc = Dd::ZERO;
+            nn_distances(points).into_iter().for_each(|d| acc.add(d));
+            acc.value() / n as f64 / hex_spacing(n)
+        }
+    }
+}
+
+/// `Σ_i single(x_i)` and `Σ_{i,j} pair(x_i, x_j)` (ordered pairs, symmetric
+/// `pair`), in double-double, parallel over rows.
+fn single_and_pair_sums(
+    points: &[DVec2],
+    single: impl Fn(DVec2) -> f64 + Sync,
+    pair: impl Fn(DVec2, DVec2) -> f64 + Sync,
+) -> (Dd, Dd) {
+    (0..points.len())
+        .into_par_iter()
+        .map(|i| {
+            let p = points[i];
+            let mut s = Dd::ZERO;
+            s.add(single(p));
+            let mut off = Dd::ZERO;
+            for &q in &points[i + 1..] {
+                off.add(pair(p, q));
+            }
+            let mut d = off.plus(off);
+            d.add(pair(p, p));
+            (s, d)
+        })
+        .reduce(
+            || (Dd::ZERO, Dd::ZERO),
+            |a, b| (a.0.plus(b.0), a.1.plus(b.1)),
+        )
+}
+
+/// `√max(c + a · single_sum / N + pair_sum / N², 0)`, evaluated in
+/// double-double.
+fn combine(constant: Dd, a: f64, single_sum: Dd, pair_sum: Dd, n: usize) -> f64 {
+    let nf = n as f64;
+    // a is a power of two (exact scaling).
+    let s = single_sum.div(nf);
+    let s = Dd {
+        hi: s.hi * a,
+        lo: s.lo * a,
+    };
+    let d2 = constant.plus(s).plus(pair_sum.div(nf).div(nf)).value();
+    d2.max(0.0).sqrt()
+}
+
+/// L2-star discrepancy by Warnock's closed form (d = 2):
+/// `T² = 1/9 − (1/(2N)) Σ_i (1−x_i²)(1−y_i²)
+///        + (1/N²) Σ_{i,j} (1−max(x_i,x_j))(1−max(y_i,y_j))`,
+/// returns `T`, the L2 norm over anchored boxes `[0, u) × [0, v)` of the
+/// local discrepancy (no lower-dimensional projections).
+///
+/// Cost O(N²/2), parallel; sums and the final difference in double-double,
+/// so the absolute error of T² is about 1e-17 (relative error of T about
+/// `1e-17 / T²`). Returns NaN for an empty set.
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::l2_star_discrepancy;
+/// // One point at the centre: T² = 1/9 − (3/4)²/2 + 1/4 = 23/288.
+/// let t = l2_star_discrepancy(&[DVec2::splat(0.5)]);
+/// assert!((t * t - 23.0 / 288.0).abs() < 1e-15);
+/// ```
+pub fn l2_star_discrepancy(points: &[DVec2]) -> f64 {
+    let n = points.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let (s, p) = single_and_pair_sums(
+        points,
+        |p| (1.0 - p.x * p.x) * (1.0 - p.y * p.y),
+        |p, q| (1.0 - p.x.max(q.x)) * (1.0 - p.y.max(q.y)),
+    );
+    combine(Dd::ratio(1.0, 9.0), -0.5, s, p, n)
+}
+
+/// Centred L2 discrepancy by Hickernell's closed form (d = 2):
+/// `CD² = (13/12)² − (2/N) Σ_i Π_k (1 + |z_ik|/2 − z_ik²/2)
+///        + (1/N²) Σ_{i,j} Π_k (1 + |z_ik|/2 + |z_jk|/2 − |x_ik − x_jk|/2)`
+/// with `z = x − 1/2`; returns `CD`. It includes the one-dimensional
+/// projections (boxes between a point and its nearest cube vertex) and is
+/// invariant under the reflections `x ↦ 1 − x` of each coordinate.
+///
+/// Cost O(N²/2), parallel, double-double accumulation (absolute error of CD²
+/// about 1e-16). Returns NaN for an empty set.
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::centered_l2_discrepancy;
+/// // One point at the centre: CD² = (13/12)² − 2 + 1 = 25/144.
+/// let cd = centered_l2_discrepancy(&[DVec2::splat(0.5)]);
+/// assert!((cd - 5.0 / 12.0).abs() < 1e-15);
+/// ```
+pub fn centered_l2_discrepancy(points: &[DVec2]) -> f64 {
+    let n = points.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let f1 = |t: f64| {
+        let z = (t - 0.5).abs();
+        1.0 + 0.5 * z - 0.5 * z * z
+    };
+    let f2 =
+        |s: f64, t: f64| 1.0 + 0.5 * (s - 0.5).abs() + 0.5 * (t - 0.5).abs() - 0.5 * (s - t).abs();
+    let (s, p) = single_and_pair_sums(
+        points,
+        |p| f1(p.x) * f1(p.y),
+        |p, q| f2(p.x, q.x) * f2(p.y, q.y),
+    );
+    combine(Dd::ratio(169.0, 144.0), -2.0, s, p, n)
+}
+
+/// Points per chunk of the periodogram (bounds the memory of the per-point
+/// exponential tables to `2 · CHUNK · size` complex numbers).
+const CHUNK: usize = 256;
+
+/// Lowest integer frequency of a grid of `size` frequencies: `−⌊size/2⌋`.
+fn k_min(size: usize) -> i64 {
+    -((size / 2) as i64)
+}
+
+/// Periodogram `P(k) = |Σ_j exp(−2πi k · x_j)|² / N` on the `size × size`
+/// grid of integer frequencies `k = (kx, ky)` with
+/// `kx, ky ∈ [−⌊size/2⌋, size − ⌊size/2⌋)` (for even `size`,
+/// `[−size/2, size/2)`), DC included (`P(0) = N`).
+///
+/// Layout: row-major, `index = (ky + ⌊size/2⌋) · size + (kx + ⌊size/2⌋)`, so
+/// the DC term is at `(size/2) · (size + 1)` for even `size`. For independent
+/// uniform points `E[P(k)] = 1` for k ≠ 0. The transform is evaluated
+/// directly (points need not be on a grid): per point one `sin_cos` per axis
+/// frequency, then a complex outer-product accumulation, cost O(N · size²)
+/// multiply-adds (+ O(N · size) `sin_cos`), parallel over rows `ky`, memory
+/// O(size² + 256 · size). Returns NaN everywhere for an empty set.
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::periodogram;
+/// let p = periodogram(&[DVec2::new(0.3, 0.7)], 8);
+/// assert_eq!(p.len(), 64);
+/// assert!(p.iter().all(|v| (v - 1.0).abs() < 1e-12));
+/// ```
+pub fn periodogram(points: &[DVec2], size: usize) -> Vec<f64> {
+    let n = points.len();
+    if n == 0 {
+        return vec![f64::NAN; size * size];
+    }
+    if size == 0 {
+        return Vec::new();
+    }
+    let k0 = k_min(size);
+    // acc[ky * 2 size + 2 kx] = Re, [+1] = Im.
+    let mut acc = vec![0.0f64; 2 * size * size];
+    let mut table = vec![0.0f64; 4 * CHUNK * size];
+    for chunk in points.chunks(CHUNK) {
+        let m = chunk.len();
+        // table layout per point j: [cos x (size), sin x (size), cos y, sin y]
+        // of the angle −2π k t.
+        table[..4 * m * size]
+            .par_chunks_mut(4 * size)
+            .zip(chunk.par_iter())
+            .for_each(|(row, p)| {
+                for idx in 0..size {
+                    let k = (k0 + idx as i64) as f64;
+                    let (sx, cx) = (-TAU * k * p.x).sin_cos();
+                    let (sy, cy) = (-TAU * k * p.y).sin_cos();
+                    row[idx] = cx;
+                    row[size + idx] = sx;
+                    row[2 * size + idx] = cy;
+                    row[3 * size + idx] = sy;
+                }
+            });
+        let table = &table[..4 * m * size];
+        acc.par_chunks_mut(2 * size)
+            .enumerate()
+            .for_each(|(ky, row)| {
+                let (re, im) = row.split_at_mut(size);
+                for t in table.chunks_exact(4 * size) {
+                    let (ex_re, rest) = t.split_at(size);
+                    let (ex_im, rest) = rest.split_at(size);
+                    let ey_re = rest[ky];
+                    let ey_im = rest[size + ky];
+                    for kx in 0..size {
+                        re[kx] += ey_re * ex_re[kx] - ey_im * ex_im[kx];
+                        im[kx] += ey_re * ex_im[kx] + ey_im * ex_re[kx];
+                    }
+                }
+            });
+    }
+    let nf = n as f64;
+    let mut out = vec![0.0f64; size * size];
+    out.par_chunks_mut(size)
+        .zip(acc.par_chunks(2 * size))
+        .for_each(|(o, row)| {
+            let (re, im) = row.split_at(size);
+            for kx in 0..size {
+                o[kx] = (re[kx] * re[kx] + im[kx] * im[kx]) / nf;
+            }
+        });
+    out
+}
+
+/// Ring index `round(|k|)` of every cell of a `size × size` periodogram, or
+/// `None` outside the complete rings `0..⌊size/2⌋`.
+fn ring_of(size: usize, idx: usize) -> Option<usize> {
+    let k0 = k_min(size);
+    let kx = (idx % size) as i64 + k0;
+    let ky = (idx / size) as i64 + k0;
+    let r = (((kx * kx + ky * ky) as f64).sqrt() + 0.5).floor() as usize;
+    (r < size / 2).then_some(r)
+}
+
+/// Values of a periodogram grouped by ring.
+fn rings(periodogram: &[f64], size: usize) -> Vec<Vec<f64>> {
+    assert_eq!(
+        periodogram.len(),
+        size * size,
+        "periodogram length must be size²"
+    );
+    let mut rings = vec![Vec::new(); size / 2];
+    for (idx, &v) in periodogram.iter().enumerate() {
+        if let Some(r) = ring_of(size, idx) {
+            rings[r].push(v);
+        }
+    }
+    rings
+}
+
+/// Radially averaged power of a [`periodogram`] of side `size`: entry `r` is
+/// the mean over the frequencies with `r − 1/2 ≤ |k| < r + 1/2` (ring of
+/// integer radius r), for the complete rings `r = 0..⌊size/2⌋` (entry 0 is
+/// the DC value N). Cost O(size²).
+///
+/// # Panics
+/// If `periodogram.len() != size * size`.
+///
+/// ```
+/// use tessera::metrics::plane::radial_average;
+/// let flat = vec![2.0; 16 * 16];
+/// let r = radial_average(&flat, 16);
+/// assert_eq!(r.len(), 8);
+/// assert!(r.iter().all(|&v| v == 2.0));
+/// ```
+pub fn radial_average(periodogram: &[f64], size: usize) -> Vec<f64> {
+    rings(periodogram, size)
+        .iter()
+        .map(|ring| ring.iter().sum::<f64>() / ring.len() as f64)
+        .collect()
+}
+
+/// Ulichney's anisotropy of a [`periodogram`] of side `size`, in decibels:
+/// for each ring r of [`radial_average`], `10 log10(s²(r) / P_r(r)²)` with
+/// `s²` the unbiased variance (divisor `count − 1`) of the ring's values and
+/// `P_r` their mean. Isotropic noise gives about 0 dB (white noise: the
+/// periodogram is exponentially distributed with variance = mean²; since
+/// `P(−k) = P(k)` only half of each ring is independent); strongly
+/// anisotropic spectra give large positive values. Entries are NaN for
+/// rings of fewer than two values (ring 0) or zero mean, and −∞ for constant
+/// rings. Cost O(size²).
+///
+/// # Panics
+/// If `periodogram.len() != size * size`.
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::{anisotropy, periodogram};
+/// let a = anisotropy(&periodogram(&uniform_random_2d(512, 3), 64), 64);
+/// assert!(a[0].is_nan());
+/// let mean = a[8..].iter().sum::<f64>() / a[8..].len() as f64;
+/// assert!(mean.abs() < 1.5);
+/// ```
+pub fn anisotropy(periodogram: &[f64], size: usize) -> Vec<f64> {
+    rings(periodogram, size)
+        .iter()
+        .map(|ring| {
+            let c = ring.len() as f64;
+            let mean = ring.iter().sum::<f64>() / c;
+            if ring.len() < 2 || mean == 0.0 {
+                return f64::NAN;
+            }
+            let var = ring.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (c - 1.0);
+            10.0 * (var / (mean * mean)).log10()
+        })
+        .collect()
+}
+
+/// Mean periodogram power over all integer frequencies `k ≠ 0` with
+/// `|k| < √N / 2` (about πN/4 frequencies): 1 in expectation for white noise,
+/// much smaller for blue noise, 0 for a perfect square lattice of √N × √N
+/// points. Evaluated with [`periodogram`] on the smallest grid containing the
+/// disc (side about √N + 2), cost O(N²) (≈ N · (√N + 2)² complex
+/// multiply-adds), parallel. Returns NaN when there is no such frequency
+/// (N ≤ 4, including the empty set).
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::low_frequency_power;
+/// let w = low_frequency_power(&uniform_random_2d(1024, 7));
+/// assert!(w > 0.85 && w < 1.15);
+/// ```
+pub fn low_frequency_power(points: &[DVec2]) -> f64 {
+    let n = points.len();
+    let r2 = n as f64 / 4.0; // |k|² < (√N / 2)²
+    let kmax = r2.sqrt().ceil() as usize;
+    let size = 2 * kmax + 2;
+    if n <= 4 {
+        return f64::NAN;
+    }
+    let p = periodogram(points, size);
+    let k0 = k_min(size);
+    let mut sum = Dd::ZERO;
+    let mut count = 0usize;
+    for (idx, &v) in p.iter().enumerate() {
+        let kx = (idx % size) as i64 + k0;
+        let ky = (idx / size) as i64 + k0;
+        let k2 = (kx * kx + ky * ky) as f64;
+        if k2 > 0.0 && k2 < r2 {
+            sum.add(v);
+            count += 1;
+        }
+    }
+    if count == 0 {
+        f64::NAN
+    } else {
+        sum.value() / count as f64
+    }
+}
+
+/// Summary of the plane metrics of one point set (serialisable).
+///
+/// ```
+/// use tessera::baselines::jittered_grid_2d;
+/// use tessera::metrics::plane::plane_report;
+/// let r = plane_report(&jittered_grid_2d(10, 1));
+/// assert_eq!(r.n, 100);
+/// println!("{}", serde_json::to_string(&r).unwrap());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PlaneReport {
+    /// Number of points.
+    pub n: usize,
+    /// [`min_distance`]: minimum distance / hexagonal spacing.
+    pub min_distance: f64,
+    /// [`mean_nn_distance`]: mean nearest-neighbour distance / hexagonal spacing.
+    pub mean_nn_distance: f64,
+    /// [`l2_star_discrepancy`]: Warnock's L2-star discrepancy.
+    pub l2_star_discrepancy: f64,
+    /// [`centered_l2_discrepancy`]: Hickernell's centred L2 discrepancy.
+    pub centered_l2_discrepancy: f64,
+    /// [`low_frequency_power`]: mean power for 0 < |k| < √N / 2.
+    pub low_frequency_power: f64,
+}
+
+/// Computes every field of [`PlaneReport`]; cost dominated by the three
+/// O(N²) terms.
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane_report;
+/// let r = plane_report(&uniform_random_2d(256, 5));
+/// assert!(r.l2_star_discrepancy > 0.0 && r.l2_star_discrepancy < 0.1);
+/// ```
+pub fn plane_report(points: &[DVec2]) -> PlaneReport {
+    let distances = (points.len() >= 2).then(|| nn_distances(points));
+    let (min_distance, mean_nn_distance) = match (&distances, points.len()) {
+        (_, 0) => (f64::NAN, f64::NAN),
+        (None, _) => (f64::INFINITY, f64::INFINITY),
+        (Some(d), n) => {
+            let mut acc = Dd::ZERO;
+            d.iter().for_each(|&v| acc.add(v));
+            let h = hex_spacing(n);
+            (
+                d.iter().copied().fold(f64::INFINITY, f64::min) / h,
+                acc.value() / n as f64 / h,
+            )
+        }
+    };
+    PlaneReport {
+        n: points.len(),
+        min_distance,
+        mean_nn_distance,
+        l2_star_discrepancy: l2_star_discrepancy(points),
+        centered_l2_discrepancy: centered_l2_discrepancy(points),
+        low_frequency_power: low_frequency_power(points),
+    }
+}
