@@ -191,3 +191,27 @@ pub fn uniform_random_2d(n: usize, seed: u64) -> Vec<DVec2> {
         })
         .collect()
 }
+
+/// Jittered HEALPix: one uniformly random point in each of the
+/// `12 nside^2` equal-area cells (stratified sampling of the sphere).
+///
+/// # Example
+/// ```
+/// let p = tessera::baselines::jittered_healpix(16, 7);
+/// assert_eq!(p.len(), 3072);
+/// assert!(p.iter().all(|v| (v.length() - 1.0).abs() < 1e-12));
+/// ```
+pub fn jittered_healpix(nside: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = SplitMix64::new(seed);
+    let mut out = Vec::with_capacity(12 * nside * nside);
+    for face in 0..12u8 {
+        for j in 0..nside {
+            for i in 0..nside {
+                let x = (i as f64 + rng.next_f64()) / nside as f64;
+                let y = (j as f64 + rng.next_f64()) / nside as f64;
+                out.push(crate::healpix::FacePoint::new(face, x, y).to_vec());
+            }
+        }
+    }
+    out
+}

@@ -7,10 +7,10 @@
 //!         if code(tile) < d: emit(sample(tile, d / capacity(level)), rank = code / d)
 //!     else: visit every child
 //! ```
-//! `magnitude` is the sample count the whole domain would receive at density
-//! 1. Ranks order the output progressively: the samples with rank below `s`
-//! are those a `s`-times smaller request accepts, so every prefix of the
-//! output is itself a well-spread set. The roots are visited in parallel and
+//! `magnitude` is the sample count the whole domain would receive at unit
+//! density. Ranks order the output progressively: the samples with rank
+//! below `s` are those an `s`-times smaller request accepts, so every prefix
+//! of the output is itself a well-spread set. The roots are visited in parallel and
 //! gathered in order, so the output does not depend on the thread count.
 
 use crate::density::{Density, Region};
@@ -92,7 +92,7 @@ where
             }
         };
         let bound = self.magnitude * bound;
-        if !(bound > 0.0) {
+        if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
@@ -167,16 +167,39 @@ where
             samples.len()
         )));
     }
-    order_by_rank(&mut samples);
+    let magnitude_density = density.constant().map(|c| magnitude * c);
+    order_by_rank(&mut samples, magnitude_density);
     if exact {
         samples.truncate(count);
     }
     Ok(samples)
 }
 
-/// Sorts samples progressively (stable, so ties keep their deterministic
-/// root order).
-fn order_by_rank<P: Send>(samples: &mut [Sample<P>]) {
+/// Sorts samples progressively. Under a constant density `d` every accepted
+/// tile sits on one level and the accepted codes are exactly `0..len`, so
+/// `rank * d` recovers each code and a scatter replaces the sort. Otherwise a
+/// stable sort keeps ties in their deterministic root order.
+fn order_by_rank<P: Copy + Send + Sync>(samples: &mut [Sample<P>], constant: Option<f64>) {
+    if let (Some(d), Some(first)) = (constant, samples.first().copied()) {
+        let mut slots: Vec<Option<Sample<P>>> = vec![None; samples.len()];
+        let mut complete = true;
+        for s in samples.iter() {
+            let code = (s.rank * d).round();
+            match slots.get_mut(code as usize) {
+                Some(slot @ None) if code >= 0.0 => *slot = Some(*s),
+                _ => {
+                    complete = false;
+                    break;
+                }
+            }
+        }
+        if complete {
+            for (out, slot) in samples.iter_mut().zip(slots) {
+                *out = slot.unwrap_or(first);
+            }
+            return;
+        }
+    }
     samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
 }
 

@@ -10,7 +10,11 @@ use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 1;
+pub const SPHERE_LUT_VERSION: u32 = 2;
+
+/// Offsets are stored as `i16` multiples of `1 / OFFSET_SCALE` cells
+/// (resolution 2.4e-4 cells, range +-8 cells): half the size of `f32`.
+pub const OFFSET_SCALE: f64 = 4096.0;
 
 /// Everything the sphere tile system needs at run time.
 ///
@@ -47,13 +51,16 @@ pub struct SphereLut {
     /// Number of importance bins per structural index.
     pub bins: u8,
     /// Offsets per level (the last one serves every deeper level), indexed
-    /// `index * bins + bin`, in the tile's frame (cells).
-    pub tables: Vec<Vec<[f32; 2]>>,
+    /// `index * bins + bin`, in the tile's frame, in cells times
+    /// [`OFFSET_SCALE`].
+    pub tables: Vec<Vec<[i16; 2]>>,
 }
 
 impl SphereLut {
     /// The importance bin of a density fraction `f` in `(0, 1]` of a level's
-    /// capacity: bins are equally spaced in `log4 f` from 1/4 (bin 0) to 1.
+    /// capacity: bins are equally spaced in `log4 f` from 1/4 (bin 0) to 1,
+    /// and `f` goes to the bin at or above it, so the tiles accepted at `f`
+    /// are a subset of those the bin was optimised with (never a crowd).
     ///
     /// # Example
     /// ```
@@ -91,10 +98,34 @@ impl SphereLut {
     /// ```
     /// let lut = tessera::lut::sphere_lut();
     /// let bytes = lut.to_bytes();
-    /// assert_eq!(*tessera::lut::SphereLut::from_bytes(&bytes).unwrap(), *lut);
+    /// assert_eq!(tessera::lut::SphereLut::from_bytes(&bytes).unwrap(), *lut);
     /// ```
     pub fn to_bytes(&self) -> Vec<u8> {
         postcard::to_allocvec(self).expect("serialising to memory cannot fail")
+    }
+
+    /// The offset (tile frame, cells) of structural index `index` at
+    /// `level` in importance bin `bin`.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// let o = lut.offset(0, 0, lut.bins as usize - 1);
+    /// assert!(tessera::tiling::polyomino::Shape::p_pentomino().contains(o));
+    /// ```
+    pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
+        let table = &self.tables[level.min(self.tables.len() - 1)];
+        let [x, y] = table[index * self.bins as usize + bin];
+        [x as f64 / OFFSET_SCALE, y as f64 / OFFSET_SCALE]
+    }
+
+    /// Quantises an offset (cells) for storage.
+    pub(crate) fn quantise(offset: [f64; 2]) -> [i16; 2] {
+        offset.map(|v| {
+            (v * OFFSET_SCALE)
+                .round()
+                .clamp(i16::MIN as f64, i16::MAX as f64) as i16
+        })
     }
 
     /// Checks every index the run-time recursion will follow.
@@ -153,9 +184,6 @@ impl SphereLut {
             if table.len() != rows * self.bins as usize {
                 return bad(&format!("offset table {level} has the wrong size"));
             }
-            if table.iter().flatten().any(|v| !v.is_finite()) {
-                return bad(&format!("offset table {level} holds a non-finite value"));
-            }
         }
         Ok(())
     }
@@ -167,7 +195,8 @@ pub(crate) fn bin_of(fraction: f64, bins: usize) -> usize {
     if position.is_nan() || position <= 0.0 {
         0
     } else {
-        (position.round() as usize).min(bins - 1)
+        // tolerate rounding just above a bin's own fraction
+        ((position - 1e-9).ceil() as usize).min(bins - 1)
     }
 }
 

@@ -168,9 +168,11 @@ fn every_prefix_is_a_progressive_subset() {
     };
     let points: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
     let full = nearest(&points);
-    for prefix in [100, 500, 1500] {
+    // stated bound: every prefix keeps at least 0.4x the full set's
+    // normalised separation (jittered HEALPix reaches < 0.5 absolute)
+    for prefix in [50, 100, 200, 500, 1000, 1500, 2000, 2500] {
         let sep = nearest(&points[..prefix]);
-        assert!(sep > 0.5 * full, "prefix {prefix}: {sep} vs {full}");
+        assert!(sep > 0.4 * full, "prefix {prefix}: {sep} vs {full}");
     }
 }
 

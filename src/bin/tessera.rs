@@ -34,6 +34,28 @@ enum Command {
         #[command(subcommand)]
         command: LutCommand,
     },
+    /// Quality measures of a point file (text formats tessera writes, or UTK binary).
+    Metrics(MetricsArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Domain {
+    /// Unit vectors `x y z`: separation, cap discrepancy, Riesz energy, covering radius.
+    Sphere,
+    /// Points `x y` in [0,1)^2: nearest-neighbour distances, discrepancies, spectrum.
+    Plane,
+}
+
+#[derive(Args)]
+struct MetricsArgs {
+    /// What the points live on.
+    #[arg(value_enum)]
+    domain: Domain,
+    /// The point file.
+    file: PathBuf,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -90,7 +112,7 @@ struct LutBuildArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Lloyd iterations per level and importance bin.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 16)]
     iterations: usize,
     /// Directory to write `<system>.lut` and `<system>.provenance.json` into.
     #[arg(long, default_value = "luts")]
@@ -114,6 +136,7 @@ fn main() -> ExitCode {
         Command::Lut {
             command: LutCommand::Build(args),
         } => lut_build(args),
+        Command::Metrics(args) => metrics(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -227,4 +250,44 @@ fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
             Ok(())
         }
     }
+}
+
+fn metrics(args: MetricsArgs) -> Result<(), Error> {
+    let dims = match args.domain {
+        Domain::Sphere => 3,
+        Domain::Plane => 2,
+    };
+    let rows = tessera::io::points::read_points(&args.file, dims)?;
+    let report = match args.domain {
+        Domain::Sphere => {
+            let points: Vec<glam::DVec3> = rows
+                .iter()
+                .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
+                .collect();
+            if let Some(bad) = points
+                .iter()
+                .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
+            {
+                return Err(Error::File {
+                    path: args.file.clone(),
+                    reason: format!("point {} is not a unit vector", bad + 1),
+                });
+            }
+            serde_json::to_value(tessera::metrics::sphere_report(&points))
+        }
+        Domain::Plane => {
+            let points: Vec<glam::DVec2> =
+                rows.iter().map(|r| glam::DVec2::new(r[0], r[1])).collect();
+            serde_json::to_value(tessera::metrics::plane_report(&points))
+        }
+    }
+    .expect("reports serialise");
+    if args.json {
+        println!("{report}");
+    } else if let Some(fields) = report.as_object() {
+        for (key, value) in fields {
+            println!("{key:>24} {value}");
+        }
+    }
+    Ok(())
 }

@@ -517,3 +517,26 @@ impl Shape {
         loop_
     }
 }
+
+impl Shape {
+    /// The shape grown by one cell in every direction (8-neighbourhood).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Shape;
+    /// assert_eq!(Shape::new(vec![(0, 0)]).dilated().cells().len(), 9);
+    /// assert!(Shape::p_pentomino().dilated().contains([-0.5, 3.5]));
+    /// ```
+    pub fn dilated(&self) -> Shape {
+        let mut cells: Vec<(i32, i32)> = self
+            .cells
+            .iter()
+            .flat_map(|&(x, y)| {
+                (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+            })
+            .collect();
+        cells.sort_unstable();
+        cells.dedup();
+        Shape::new(cells)
+    }
+}

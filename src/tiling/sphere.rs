@@ -209,9 +209,7 @@ impl SphereTiling {
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        let table = &lut.tables[(tile.level as usize).min(lut.tables.len() - 1)];
-        let o = table[tile.index as usize * lut.bins as usize + lut.bin(fraction)];
-        [o[0] as f64, o[1] as f64]
+        lut.offset(tile.level as usize, tile.index as usize, lut.bin(fraction))
     }
 
     /// The shape of every tile.
