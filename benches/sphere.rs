@@ -10,7 +10,12 @@ use tessera::Sampler;
 
 const N: usize = 10_000_000;
 
-fn to_bytes(points: &[glam::DVec3]) -> Vec<u8> {
+fn to_bytes<I>(points: I) -> Vec<u8>
+where
+    I: IntoIterator<Item = glam::DVec3>,
+    I::IntoIter: ExactSizeIterator,
+{
+    let points = points.into_iter();
     let mut out = Vec::with_capacity(20 + 24 * points.len());
     write_sphere(&mut out, points, SphereFormat::Bin, |_| 0.0).expect("writing to memory");
     out
@@ -30,14 +35,13 @@ fn uniform_throughput(c: &mut Criterion) {
             b.iter(|| {
                 pool.install(|| {
                     let samples = sampler.generate().expect("uniform sampling");
-                    let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
-                    black_box(to_bytes(&points))
+                    black_box(to_bytes(samples.iter().map(|s| s.position)))
                 })
             })
         });
     }
     group.bench_function("fibonacci_1_thread", |b| {
-        b.iter(|| black_box(to_bytes(&spherical_fibonacci(N))))
+        b.iter(|| black_box(to_bytes(spherical_fibonacci(N))))
     });
     group.finish();
 }

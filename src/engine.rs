@@ -50,6 +50,16 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
+    collect_parts(system, density, magnitude).concat()
+}
+
+/// The accepted samples of each root's subtree, in root order.
+fn collect_parts<S, D>(system: &S, density: &D, magnitude: f64) -> Vec<Vec<Sample<S::Point>>>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
     let walker = Walker {
         system,
         density,
@@ -57,15 +67,18 @@ where
         constant: density.constant(),
     };
     let roots = system.roots();
-    let parts: Vec<Vec<Sample<S::Point>>> = roots
+    // under a constant density every root receives about the same share
+    let share = walker.constant.map_or(0, |c| {
+        (magnitude * c / roots.len() as f64 * 1.05) as usize + 16
+    });
+    roots
         .par_iter()
         .map(|root| {
-            let mut out = Vec::new();
+            let mut out = Vec::with_capacity(share);
             walker.visit(root, &mut out);
             out
         })
-        .collect();
-    parts.concat()
+        .collect()
 }
 
 struct Walker<'a, S, D: ?Sized> {
@@ -151,57 +164,109 @@ where
             "the density's mean over the domain is {mean}; it must be positive and finite"
         )));
     }
+    if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
+        // constant density: the first `count` codes of one level, no recursion
+        let (fraction, d) = (stream.fraction, stream.d);
+        let sample = |code: u64, tile: &S::Tile| Sample {
+            position: system.sample(tile, fraction),
+            rank: code as f64 / d,
+        };
+        if let Some(samples) = system.map_code_order(stream.level, count, &sample) {
+            return Ok(samples);
+        }
+    }
     let mut magnitude = count as f64 / mean;
-    let mut samples = collect(system, density, magnitude);
+    let mut parts = collect_parts(system, density, magnitude);
+    let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..16 {
-        if !exact || samples.len() >= count {
+        let found = total(&parts);
+        if !exact || found >= count {
             break;
         }
-        let ratio = count as f64 / samples.len().max(1) as f64;
+        let ratio = count as f64 / found.max(1) as f64;
         magnitude *= (ratio * 1.01).clamp(1.001, 4.0);
-        samples = collect(system, density, magnitude);
+        parts = collect_parts(system, density, magnitude);
     }
-    if exact && samples.len() < count {
+    if exact && total(&parts) < count {
         return Err(Error::Request(format!(
             "only {} samples fit at the deepest level; {count} were requested",
-            samples.len()
+            total(&parts)
         )));
     }
-    let magnitude_density = density.constant().map(|c| magnitude * c);
-    order_by_rank(&mut samples, magnitude_density);
+    // stable, so ties keep their deterministic root order
+    let mut samples = parts.concat();
+    samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
     if exact {
         samples.truncate(count);
     }
     Ok(samples)
 }
 
-/// Sorts samples progressively. Under a constant density `d` every accepted
-/// tile sits on one level and the accepted codes are exactly `0..len`, so
-/// `rank * d` recovers each code and a scatter replaces the sort. Otherwise a
-/// stable sort keeps ties in their deterministic root order.
-fn order_by_rank<P: Copy + Send + Sync>(samples: &mut [Sample<P>], constant: Option<f64>) {
-    if let (Some(d), Some(first)) = (constant, samples.first().copied()) {
-        let mut slots: Vec<Option<Sample<P>>> = vec![None; samples.len()];
-        let mut complete = true;
-        for s in samples.iter() {
-            let code = (s.rank * d).round();
-            match slots.get_mut(code as usize) {
-                Some(slot @ None) if code >= 0.0 => *slot = Some(*s),
-                _ => {
-                    complete = false;
-                    break;
-                }
-            }
-        }
-        if complete {
-            for (out, slot) in samples.iter_mut().zip(slots) {
-                *out = slot.unwrap_or(first);
-            }
-            return;
-        }
-    }
-    samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
+/// Uniform samples in progressive order, computed one at a time from their
+/// codes: memory stays O(depth) however many are drawn.
+///
+/// # Example
+/// ```
+/// use tessera::{engine, tiling::sphere::SphereTiling};
+/// let tiling = SphereTiling::default();
+/// let first: Vec<_> = engine::stream(&tiling, 1_000_000_000).unwrap().take(3).collect();
+/// assert_eq!(first.len(), 3);
+/// ```
+pub struct Stream<'a, S: TileSystem> {
+    system: &'a S,
+    level: u32,
+    fraction: f64,
+    d: f64,
+    next: u64,
+    end: u64,
 }
+
+/// A progressive stream of `count` uniform samples, if the system finds
+/// tiles from codes (see [`TileSystem::tile_with_code`]) and `count` fits
+/// the deepest level.
+///
+/// # Example
+/// ```
+/// use tessera::{engine, tiling::sphere::SphereTiling};
+/// assert_eq!(engine::stream(&SphereTiling::default(), 10).unwrap().count(), 10);
+/// ```
+pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> {
+    let d = count as f64;
+    let level = (0..=system.max_level()).find(|&l| system.capacity(l) >= d)?;
+    system.tile_with_code(level, 0)?;
+    Some(Stream {
+        system,
+        level,
+        fraction: d / system.capacity(level),
+        d,
+        next: 0,
+        end: count as u64,
+    })
+}
+
+impl<S: TileSystem> Iterator for Stream<'_, S> {
+    type Item = Sample<S::Point>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.next >= self.end {
+            return None;
+        }
+        let tile = self.system.tile_with_code(self.level, self.next)?;
+        let sample = Sample {
+            position: self.system.sample(&tile, self.fraction),
+            rank: self.next as f64 / self.d,
+        };
+        self.next += 1;
+        Some(sample)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = (self.end - self.next) as usize;
+        (left, Some(left))
+    }
+}
+
+impl<S: TileSystem> ExactSizeIterator for Stream<'_, S> {}
 
 /// The pdf (per unit measure of the domain) the samples follow at a point.
 ///

@@ -191,13 +191,17 @@ impl SphereLut {
 
 /// Bin of a density fraction, shared by the run time and the optimiser.
 pub(crate) fn bin_of(fraction: f64, bins: usize) -> usize {
-    let position = (1.0 + fraction.log(4.0)) * (bins - 1) as f64;
-    if position.is_nan() || position <= 0.0 {
-        0
-    } else {
-        // tolerate rounding just above a bin's own fraction
-        ((position - 1e-9).ceil() as usize).min(bins - 1)
-    }
+    let edges: Vec<f64> = (0..bins).map(|b| fraction_of_bin(b, bins)).collect();
+    bin_in(&edges, fraction)
+}
+
+/// The first bin whose optimised fraction is at or above `fraction` (with a
+/// relative tolerance for rounding), given those fractions in increasing order.
+pub(crate) fn bin_in(edges: &[f64], fraction: f64) -> usize {
+    edges
+        .iter()
+        .position(|&edge| fraction <= edge * (1.0 + 1e-9))
+        .unwrap_or(edges.len() - 1)
 }
 
 /// The density fraction an importance bin is optimised for.

@@ -243,3 +243,36 @@ proptest! {
             "inside {} expected {}", inside, expected);
     }
 }
+
+#[test]
+fn uniform_fast_path_streaming_and_recursion_agree() {
+    let tiling = SphereTiling::default();
+    for n in [1usize, 240, 1000, 3072] {
+        let fast = engine::generate(&tiling, &Uniform, n, true).unwrap();
+        let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
+        assert_eq!(fast, streamed);
+        // the general recursion, ranked by sorting, finds the same set in the same order
+        let mut recursed = engine::collect(&tiling, &Uniform, n as f64);
+        recursed.sort_by(|a, b| a.rank.total_cmp(&b.rank));
+        assert_eq!(fast, recursed, "n = {n}");
+    }
+}
+
+#[test]
+fn streams_reach_the_deepest_level_without_buffering() {
+    let tiling = SphereTiling::default();
+    // 10^18 samples would need level 26; the first few come at once
+    let first: Vec<_> = engine::stream(&tiling, 1_000_000_000_000_000_000)
+        .unwrap()
+        .take(1000)
+        .collect();
+    let points: Vec<DVec3> = first.iter().map(|s| s.position).collect();
+    assert!(points
+        .iter()
+        .all(|p| p.is_finite() && (p.length() - 1.0).abs() < 1e-12));
+    let distinct: HashSet<[u64; 3]> = points
+        .iter()
+        .map(|p| p.to_array().map(f64::to_bits))
+        .collect();
+    assert_eq!(distinct.len(), points.len());
+}

@@ -170,9 +170,9 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let density = tessera::density::sphere::parse(&args.density)?;
     let tiling = SphereTiling::default();
     let samples = engine::generate(&tiling, &density, args.count, !args.expected)?;
-    let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
     let mut out = create(&args.output)?;
-    tessera::io::points::write_sphere(&mut out, &points, format, |p| {
+    let points = samples.iter().map(|s| s.position);
+    tessera::io::points::write_sphere(&mut out, points, format, |p| {
         engine::pdf(&tiling, &density, p)
     })
     .and_then(|()| out.flush())

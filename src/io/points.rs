@@ -74,15 +74,20 @@ pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std
 /// ```
 /// use tessera::io::points::{write_sphere, SphereFormat};
 /// let mut out = Vec::new();
-/// write_sphere(&mut out, &[glam::DVec3::Z], SphereFormat::LonLat, |_| 0.0).unwrap();
+/// write_sphere(&mut out, [glam::DVec3::Z], SphereFormat::LonLat, |_| 0.0).unwrap();
 /// assert_eq!(String::from_utf8(out).unwrap(), "0 90\n");
 /// ```
-pub fn write_sphere(
+pub fn write_sphere<I>(
     out: &mut impl Write,
-    points: &[DVec3],
+    points: I,
     format: SphereFormat,
     pdf: impl Fn(DVec3) -> f64,
-) -> std::io::Result<()> {
+) -> std::io::Result<()>
+where
+    I: IntoIterator<Item = DVec3>,
+    I::IntoIter: ExactSizeIterator,
+{
+    let points = points.into_iter();
     match format {
         SphereFormat::Xyz => {
             for p in points {
@@ -90,30 +95,31 @@ pub fn write_sphere(
             }
         }
         SphereFormat::LonLat => {
-            for &p in points {
+            for p in points {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
                 writeln!(out, "{lon} {lat}")?;
             }
         }
         SphereFormat::Csv => {
             writeln!(out, "x,y,z,lon,lat,pdf")?;
-            for &p in points {
+            for p in points {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
                 writeln!(out, "{},{},{},{lon},{lat},{}", p.x, p.y, p.z, pdf(p))?;
             }
         }
         SphereFormat::Bin => {
             write_utk_header(out, points.len(), 3)?;
-            let mut buffer = Vec::with_capacity(points.len().min(1 << 16) * 24);
-            for chunk in points.chunks(1 << 16) {
-                buffer.clear();
-                for p in chunk {
-                    for v in [p.x, p.y, p.z] {
-                        buffer.extend_from_slice(&v.to_le_bytes());
-                    }
+            let mut buffer = Vec::with_capacity(24 << 12);
+            for p in points {
+                for v in [p.x, p.y, p.z] {
+                    buffer.extend_from_slice(&v.to_le_bytes());
                 }
-                out.write_all(&buffer)?;
+                if buffer.len() >= 24 << 12 {
+                    out.write_all(&buffer)?;
+                    buffer.clear();
+                }
             }
+            out.write_all(&buffer)?;
         }
     }
     Ok(())

@@ -48,6 +48,29 @@ pub trait TileSystem: Sync {
     fn code(&self, tile: &Self::Tile) -> u64;
     /// The region a density bounds itself over.
     fn region(&self, tile: &Self::Tile) -> Self::Region;
+    /// The tile of `level` whose code is `code`, when the system can find it
+    /// directly (base-A codes can: their digits spell the path from the
+    /// root). Lets uniform requests stream in code order with no recursion,
+    /// sort or buffer. `None` when unsupported or out of range.
+    fn tile_with_code(&self, level: u32, code: u64) -> Option<Self::Tile> {
+        let _ = (level, code);
+        None
+    }
+    /// `f(code, tile)` for the tiles of `level` with codes `0..count`, in
+    /// code order (what a constant density accepts), or `None` when the
+    /// system cannot find tiles from codes. The default finds each by
+    /// [`TileSystem::tile_with_code`]; systems with base-A codes share the
+    /// parents of each digit block instead.
+    fn map_code_order<T: Send>(
+        &self,
+        level: u32,
+        count: usize,
+        f: &(dyn Fn(u64, &Self::Tile) -> T + Sync),
+    ) -> Option<Vec<T>> {
+        (0..count as u64)
+            .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
+            .collect()
+    }
     /// The sample position of an accepted tile, when the local density is
     /// `fraction * capacity(level)` (fraction in `(0, 1]`): reference point
     /// plus the table offset in the tile's basis.

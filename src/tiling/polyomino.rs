@@ -89,15 +89,7 @@ impl Orientation {
     /// assert_eq!(Orientation::IDENTITY.matrix(), [[1, 0], [0, 1]]);
     /// ```
     pub fn matrix(self) -> [[i32; 2]; 2] {
-        let mirror = if self.0 & 4 != 0 { -1 } else { 1 };
-        let (c, s) = match self.0 & 3 {
-            0 => (1, 0),
-            1 => (0, 1),
-            2 => (-1, 0),
-            _ => (0, -1),
-        };
-        // rotation * diag(mirror, 1)
-        [[c * mirror, -s], [s * mirror, c]]
+        MATRICES[self.0 as usize]
     }
 
     /// Applies the orientation to an integer vector.
@@ -136,21 +128,7 @@ impl Orientation {
     /// assert_eq!(a.then(b).apply((1, 0)), b.apply(a.apply((1, 0))));
     /// ```
     pub fn then(self, outer: Orientation) -> Orientation {
-        let (a, b) = (outer.matrix(), self.matrix());
-        let product = [
-            [
-                a[0][0] * b[0][0] + a[0][1] * b[1][0],
-                a[0][0] * b[0][1] + a[0][1] * b[1][1],
-            ],
-            [
-                a[1][0] * b[0][0] + a[1][1] * b[1][0],
-                a[1][0] * b[0][1] + a[1][1] * b[1][1],
-            ],
-        ];
-        *Orientation::ALL
-            .iter()
-            .find(|o| o.matrix() == product)
-            .expect("D4 is closed under composition")
+        Orientation(COMPOSE[outer.0 as usize][self.0 as usize])
     }
 
     /// The inverse orientation.
@@ -162,12 +140,81 @@ impl Orientation {
     /// assert_eq!(o.then(o.inverse()), Orientation::IDENTITY);
     /// ```
     pub fn inverse(self) -> Orientation {
-        *Orientation::ALL
-            .iter()
-            .find(|o| o.then(self) == Orientation::IDENTITY)
-            .expect("every element of D4 has an inverse")
+        Orientation(INVERSE[self.0 as usize])
     }
 }
+
+/// `rotation(turns) * diag(mirror, 1)` for every orientation index.
+const MATRICES: [[[i32; 2]; 2]; 8] = {
+    let mut out = [[[0; 2]; 2]; 8];
+    let mut k = 0;
+    while k < 8 {
+        let mirror = if k & 4 != 0 { -1 } else { 1 };
+        let (c, s) = match k & 3 {
+            0 => (1, 0),
+            1 => (0, 1),
+            2 => (-1, 0),
+            _ => (0, -1),
+        };
+        out[k] = [[c * mirror, -s], [s * mirror, c]];
+        k += 1;
+    }
+    out
+};
+
+/// `COMPOSE[a][b]`: the index of the matrix product `MATRICES[a] * MATRICES[b]`.
+const COMPOSE: [[u8; 8]; 8] = {
+    let mut out = [[0u8; 8]; 8];
+    let mut a = 0;
+    while a < 8 {
+        let mut b = 0;
+        while b < 8 {
+            let (x, y) = (MATRICES[a], MATRICES[b]);
+            let p = [
+                [
+                    x[0][0] * y[0][0] + x[0][1] * y[1][0],
+                    x[0][0] * y[0][1] + x[0][1] * y[1][1],
+                ],
+                [
+                    x[1][0] * y[0][0] + x[1][1] * y[1][0],
+                    x[1][0] * y[0][1] + x[1][1] * y[1][1],
+                ],
+            ];
+            let mut k = 0;
+            while k < 8 {
+                let m = MATRICES[k];
+                if m[0][0] == p[0][0]
+                    && m[0][1] == p[0][1]
+                    && m[1][0] == p[1][0]
+                    && m[1][1] == p[1][1]
+                {
+                    out[a][b] = k as u8;
+                }
+                k += 1;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    out
+};
+
+/// `INVERSE[a]`: the index whose product with `a` is the identity.
+const INVERSE: [u8; 8] = {
+    let mut out = [0u8; 8];
+    let mut a = 0;
+    while a < 8 {
+        let mut b = 0;
+        while b < 8 {
+            if COMPOSE[a][b] == 0 {
+                out[a] = b as u8;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    out
+};
 
 /// A polyomino: a finite set of unit cells given by their lower-left corners.
 ///

@@ -17,6 +17,7 @@ use crate::lut::SphereLut;
 use crate::tiling::polyomino::{Placement, Shape};
 use crate::tiling::TileSystem;
 use glam::DVec3;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
@@ -109,6 +110,12 @@ impl SphereRegion {
 pub struct SphereTiling {
     lut: Arc<SphereLut>,
     shape: Shape,
+    /// The roots, ordered by code (rank).
+    roots_by_code: Vec<SphereTile>,
+    /// `child_of_digit[rule][digit]`: which child carries a digit.
+    child_of_digit: [[u8; 4]; 2],
+    /// The density fraction each importance bin was optimised for.
+    bin_fractions: Vec<f64>,
 }
 
 impl Default for SphereTiling {
@@ -128,10 +135,26 @@ impl SphereTiling {
     /// assert_eq!(sphere.lut().rules.len(), 2);
     /// ```
     pub fn new(lut: Arc<SphereLut>) -> Self {
-        SphereTiling {
+        let mut tiling = SphereTiling {
             lut,
             shape: Shape::p_pentomino(),
+            roots_by_code: Vec::new(),
+            child_of_digit: [[0; 4]; 2],
+            bin_fractions: Vec::new(),
+        };
+        let bins = tiling.lut.bins as usize;
+        tiling.bin_fractions = (0..bins)
+            .map(|b| crate::lut::fraction_of_bin(b, bins))
+            .collect();
+        let mut roots = tiling.roots();
+        roots.sort_by_key(|t| t.code);
+        tiling.roots_by_code = roots;
+        for (rule, digits) in tiling.lut.child_digit.iter().enumerate().take(2) {
+            for (child, &digit) in digits.iter().enumerate() {
+                tiling.child_of_digit[rule][digit as usize % 4] = child as u8;
+            }
         }
+        tiling
     }
 
     /// The table driving this tiling.
@@ -209,7 +232,8 @@ impl SphereTiling {
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        lut.offset(tile.level as usize, tile.index as usize, lut.bin(fraction))
+        let bin = crate::lut::bin_in(&self.bin_fractions, fraction);
+        lut.offset(tile.level as usize, tile.index as usize, bin)
     }
 
     /// The shape of every tile.
@@ -285,6 +309,54 @@ impl TileSystem for SphereTiling {
             face: tile.face,
             cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
         }
+    }
+
+    fn map_code_order<T: Send>(
+        &self,
+        level: u32,
+        count: usize,
+        f: &(dyn Fn(u64, &SphereTile) -> T + Sync),
+    ) -> Option<Vec<T>> {
+        if level > MAX_LEVEL || count as f64 > self.capacity(level) {
+            return None;
+        }
+        if level == 0 {
+            let roots = self.roots_by_code[..count].iter().enumerate();
+            return Some(roots.map(|(code, t)| f(code as u64, t)).collect());
+        }
+        // codes `digit * m + c` share their parent with code `c` one level
+        // up: find the parents once, then every digit block from them
+        let m = self.capacity(level - 1) as usize;
+        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
+        let mut out = Vec::with_capacity(count);
+        for digit in 0..4 {
+            let start = digit * m;
+            if start >= count {
+                break;
+            }
+            let block = parents[..(count - start).min(m)].par_iter().enumerate();
+            out.par_extend(block.map(|(c, p)| {
+                let child = self.child_of_digit[p.rule as usize][digit] as usize;
+                f((start + c) as u64, &self.subdivide(p, child))
+            }));
+        }
+        Some(out)
+    }
+
+    fn tile_with_code(&self, level: u32, code: u64) -> Option<SphereTile> {
+        if level > MAX_LEVEL || code as f64 >= self.capacity(level) {
+            return None;
+        }
+        let mut tile = *self
+            .roots_by_code
+            .get((code % ROOT_COUNT as u64) as usize)?;
+        let mut digits = code / ROOT_COUNT as u64;
+        for _ in 0..level {
+            let child = self.child_of_digit[tile.rule as usize][(digits & 3) as usize];
+            tile = self.subdivide(&tile, child as usize);
+            digits >>= 2;
+        }
+        Some(tile)
     }
 
     fn sample(&self, tile: &SphereTile, fraction: f64) -> DVec3 {

@@ -1,0 +1,134 @@
+//! The command line, end to end: formats, errors, drawings, metrics.
+
+use std::process::Command;
+
+fn tessera(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stdout(args: &[&str]) -> String {
+    let out = tessera(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn xyz_lonlat_and_csv_formats() {
+    let xyz = stdout(&["sphere", "--density", "uniform", "-n", "100"]);
+    assert_eq!(xyz.lines().count(), 100);
+    for line in xyz.lines() {
+        let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+        assert_eq!(v.len(), 3);
+        assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-12);
+    }
+    let lonlat = stdout(&["sphere", "-n", "50", "--format", "lonlat"]);
+    for line in lonlat.lines() {
+        let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+        assert!((-180.0..180.0).contains(&v[0]) && (-90.0..=90.0).contains(&v[1]));
+    }
+    let csv = stdout(&[
+        "sphere",
+        "-n",
+        "10",
+        "--format",
+        "csv",
+        "--density",
+        "cap:0,90,30,10",
+    ]);
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,y,z,lon,lat,pdf"));
+    assert_eq!(lines.count(), 10);
+}
+
+#[test]
+fn binary_format_is_utk() {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("points.bin");
+    stdout(&[
+        "sphere",
+        "-n",
+        "77",
+        "--format",
+        "bin",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(bytes.len(), 20 + 77 * 3 * 8);
+    assert_eq!(&bytes[..4], &0x214B5455u32.to_le_bytes());
+    assert_eq!(&bytes[4..8], &[5, 0, 0, 0]);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 1);
+    assert_eq!(u32::from_le_bytes(bytes[12..16].try_into().unwrap()), 77);
+    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 3);
+    // metrics read it back
+    let json = stdout(&["metrics", "sphere", path.to_str().unwrap(), "--json"]);
+    for key in [
+        "n",
+        "separation",
+        "cap_discrepancy_l2",
+        "riesz1_normalized",
+        "covering_radius",
+        "mesh_ratio",
+    ] {
+        assert!(
+            json.contains(&format!("\"{key}\"")),
+            "{key} missing in {json}"
+        );
+    }
+    let svg = dir.join("tiles.svg");
+    stdout(&[
+        "tiles",
+        "--system",
+        "sphere",
+        "--level",
+        "1",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    let drawing = std::fs::read_to_string(&svg).unwrap();
+    assert_eq!(drawing.matches("<polygon").count(), 960);
+    assert_eq!(drawing.matches("<circle").count(), 960);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_input_gets_a_clear_error_and_no_panic() {
+    for (args, needle) in [
+        (vec!["sphere", "-n", "abc"], "abc"),
+        (vec!["sphere", "-n", "-5"], "-5"),
+        (
+            vec!["sphere", "-n", "10", "--density", "cap:1,2"],
+            "cap:1,2",
+        ),
+        (vec!["sphere", "-n", "10", "--density", "blob"], "blob"),
+        (vec!["sphere", "-n", "10", "--format", "pdf"], "pdf"),
+        (vec!["sphere", "-n", "10", "--bogus"], "--bogus"),
+        (vec!["metrics", "sphere", "/no/such/file"], "/no/such/file"),
+        (
+            vec![
+                "tiles",
+                "--system",
+                "sphere",
+                "--level",
+                "9",
+                "--svg",
+                "/tmp/x.svg",
+            ],
+            "level 9",
+        ),
+    ] {
+        let out = tessera(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
