@@ -98,6 +98,8 @@ pub struct BuildReport {
     pub missing_transitions: usize,
     /// Mean squared displacement of the last Lloyd iteration per table level.
     pub lloyd_residual: Vec<f64>,
+    /// Wall time of the Lloyd relaxation of each table level, seconds.
+    pub lloyd_seconds: Vec<f64>,
     /// Wall time of each stage, seconds.
     pub stage_seconds: Vec<(String, f64)>,
 }
@@ -865,6 +867,7 @@ fn relax(
         .sum();
     let mut done = 0;
     for level in 0..options.table_levels as u32 {
+        let level_clock = std::time::Instant::now();
         let tiles = tiles_at(tiling, level);
         let exact = level < options.exact_levels as u32;
         let rows: Vec<u32> = if exact {
@@ -912,6 +915,7 @@ fn relax(
             progress("lloyd", done, total);
         }
         report.lloyd_residual.push(residual);
+        report.lloyd_seconds.push(level_clock.elapsed().as_secs_f64());
         tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
     }
     tables
@@ -967,7 +971,11 @@ fn relax_bin(
                     .to_vec()
             })
             .collect();
-        let points: Vec<[f64; 3]> = sites.iter().map(|v| v.to_array()).collect();
+        // the tiling's symmetries give many sites equal coordinates, which
+        // degrades the k-d tree badly; a fixed generic rotation (distances
+        // unchanged) breaks the ties
+        let skew = glam::DQuat::from_euler(glam::EulerRot::ZXY, 0.3141, 0.2718, 0.1618);
+        let points: Vec<[f64; 3]> = sites.iter().map(|&v| (skew * v).to_array()).collect();
         let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(&points);
         // deterministic: each block of rows sums in order, blocks merge in order
         let blocks: Vec<HashMap<u32, DVec3>> = (0..12 * qside)
@@ -982,7 +990,7 @@ fn relax_bin(
                         (j as f64 + 0.5) / qside as f64,
                     )
                     .to_vec();
-                    let nearest = tree.nearest_one::<SquaredEuclidean>(&q.to_array()).item;
+                    let nearest = tree.nearest_one::<SquaredEuclidean>(&(skew * q).to_array()).item;
                     *sums.entry(nearest).or_default() += q;
                 }
                 sums
