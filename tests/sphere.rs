@@ -9,20 +9,9 @@ use tessera::density::sphere::{angle_between, Cap};
 use tessera::density::Uniform;
 use tessera::healpix::FacePoint;
 use tessera::tiling::polyomino::{Rule, Shape};
-use tessera::tiling::sphere::{SphereTile, SphereTiling, FACE_LIPSCHITZ};
+use tessera::tiling::sphere::{SphereTiling, FACE_LIPSCHITZ};
 use tessera::tiling::TileSystem;
 use tessera::{engine, Sampler};
-
-fn tiles_at(tiling: &SphereTiling, level: u32) -> Vec<SphereTile> {
-    let mut tiles = tiling.roots();
-    for _ in 0..level {
-        tiles = tiles
-            .iter()
-            .flat_map(|t| (0..4).map(move |c| tiling.child(t, c)))
-            .collect();
-    }
-    tiles
-}
 
 #[test]
 fn the_p_pentomino_has_exactly_two_dissections_and_both_tile_the_parent() {
@@ -39,7 +28,7 @@ fn the_p_pentomino_has_exactly_two_dissections_and_both_tile_the_parent() {
 fn every_level_partitions_the_healpix_cells_into_pentominoes() {
     let tiling = SphereTiling::default();
     for level in 0..=3u32 {
-        let tiles = tiles_at(&tiling, level);
+        let tiles = tiling.tiles(level);
         assert_eq!(tiles.len(), 240 << (2 * level));
         let nside = SphereTiling::nside(level) as i32;
         let mut cells = HashSet::new();
@@ -64,7 +53,7 @@ fn every_level_partitions_the_healpix_cells_into_pentominoes() {
 fn codes_of_a_level_are_a_permutation() {
     let tiling = SphereTiling::default();
     for level in 0..=3u32 {
-        let mut codes: Vec<u64> = tiles_at(&tiling, level).iter().map(|t| t.code).collect();
+        let mut codes: Vec<u64> = tiling.tiles(level).iter().map(|t| t.code).collect();
         codes.sort_unstable();
         assert!(
             codes.iter().enumerate().all(|(i, &c)| c == i as u64),
@@ -79,7 +68,7 @@ fn bounding_caps_contain_their_tiles() {
     let shape = Shape::p_pentomino();
     let mut worst: f64 = 0.0;
     for level in [0u32, 1, 3] {
-        for (n, t) in tiles_at(&tiling, level).iter().enumerate() {
+        for (n, t) in tiling.tiles(level).iter().enumerate() {
             if level == 3 && n % 7 != 0 {
                 continue;
             }
@@ -126,7 +115,7 @@ fn full_levels_put_one_point_in_each_pentomino() {
         }
         assert!(per_face.iter().all(|&c| c == n / 12), "{per_face:?}");
         // each point inside its own tile
-        for t in tiles_at(&tiling, level) {
+        for t in tiling.tiles(level) {
             let offset = tiling.offset(&t, 1.0);
             assert!(tiling.shape().contains(offset));
         }

@@ -169,11 +169,11 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let format: SphereFormat = args.format.parse()?;
     let density = tessera::density::sphere::parse(&args.density)?;
     let tiling = SphereTiling::default();
-    let samples = engine::generate(&tiling, &density, args.count, !args.expected)?;
+    let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
     let mut out = create(&args.output)?;
     let points = samples.iter().map(|s| s.position);
     tessera::io::points::write_sphere(&mut out, points, format, |p| {
-        engine::pdf(&tiling, &density, p)
+        engine::pdf(&tiling, &*density, p)
     })
     .and_then(|()| out.flush())
     .map_err(io_error(&args.output))

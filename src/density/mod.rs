@@ -96,21 +96,3 @@ impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
         (**self).constant()
     }
 }
-
-impl<R: Region, D: Density<R> + ?Sized + Send> Density<R> for Box<D> {
-    fn bound(&self, region: &R) -> f64 {
-        (**self).bound(region)
-    }
-    fn average(&self, region: &R) -> f64 {
-        (**self).average(region)
-    }
-    fn value(&self, point: R::Point) -> f64 {
-        (**self).value(point)
-    }
-    fn mean(&self) -> f64 {
-        (**self).mean()
-    }
-    fn constant(&self) -> Option<f64> {
-        (**self).constant()
-    }
-}

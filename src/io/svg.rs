@@ -20,13 +20,7 @@ const HEIGHT: f64 = 720.0;
 /// assert!(svg.starts_with("<svg") && svg.matches("<polygon").count() == 240);
 /// ```
 pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -> String {
-    let mut tiles: Vec<SphereTile> = tiling.roots();
-    for _ in 0..level {
-        tiles = tiles
-            .iter()
-            .flat_map(|t| (0..4).map(move |c| tiling.child(t, c)))
-            .collect();
-    }
+    let tiles: Vec<SphereTile> = tiling.tiles(level);
     let capacity = tiling.capacity(level);
     let outline = tiling.shape().outline();
     let mut svg = String::new();

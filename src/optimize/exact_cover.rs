@@ -152,15 +152,10 @@ impl Search<'_> {
     }
 }
 
-/// Deterministic Fisher-Yates shuffle driven by SplitMix64.
+/// Deterministic Fisher-Yates shuffle.
 fn shuffle<T>(items: &mut [T], seed: u64) {
-    let mut state = seed;
+    let mut rng = crate::baselines::SplitMix64::new(seed);
     for i in (1..items.len()).rev() {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        items.swap(i, (z % (i as u64 + 1)) as usize);
+        items.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
     }
 }

@@ -467,18 +467,6 @@ fn root_ranks(lut: &SphereLut) -> Vec<u32> {
     })
 }
 
-/// All tiles of a level in tree-index order.
-pub(crate) fn tiles_at(tiling: &SphereTiling, level: u32) -> Vec<SphereTile> {
-    let mut tiles = tiling.roots();
-    for _ in 0..level {
-        tiles = tiles
-            .par_iter()
-            .flat_map_iter(|t| (0..4).map(move |c| tiling.child(t, c)))
-            .collect();
-    }
-    tiles
-}
-
 // -------------------------------------------------------------- classes ----
 
 struct Classes {
@@ -719,7 +707,7 @@ fn classify(
     let total = (first..=last).map(|l| 4u64.pow(l)).sum::<u64>();
     let mut done = 0;
     for level in first..=last {
-        let tiles = tiles_at(tiling, level);
+        let tiles = tiling.tiles(level);
         let map = CellMap::new(tiling, &tiles, level);
         let owner = |cell: Cell| Some(map.get(cell));
         let signatures: Vec<Vec<(i16, i16, u32)>> = (0..tiles.len())
@@ -868,7 +856,7 @@ fn relax(
     let mut done = 0;
     for level in 0..options.table_levels as u32 {
         let level_clock = std::time::Instant::now();
-        let tiles = tiles_at(tiling, level);
+        let tiles = tiling.tiles(level);
         let exact = level < options.exact_levels as u32;
         let rows: Vec<u32> = if exact {
             (0..tiles.len() as u32).collect()
@@ -915,7 +903,9 @@ fn relax(
             progress("lloyd", done, total);
         }
         report.lloyd_residual.push(residual);
-        report.lloyd_seconds.push(level_clock.elapsed().as_secs_f64());
+        report
+            .lloyd_seconds
+            .push(level_clock.elapsed().as_secs_f64());
         tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
     }
     tables
@@ -990,7 +980,9 @@ fn relax_bin(
                         (j as f64 + 0.5) / qside as f64,
                     )
                     .to_vec();
-                    let nearest = tree.nearest_one::<SquaredEuclidean>(&(skew * q).to_array()).item;
+                    let nearest = tree
+                        .nearest_one::<SquaredEuclidean>(&(skew * q).to_array())
+                        .item;
                     *sums.entry(nearest).or_default() += q;
                 }
                 sums

@@ -201,6 +201,25 @@ impl SphereTiling {
         }
     }
 
+    /// Every tile of a level, in tree order (children of the first root
+    /// first). `240 * 4^level` tiles: meant for small levels.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// assert_eq!(SphereTiling::default().tiles(2).len(), 3840);
+    /// ```
+    pub fn tiles(&self, level: u32) -> Vec<SphereTile> {
+        let mut tiles = self.roots();
+        for _ in 0..level {
+            tiles = tiles
+                .par_iter()
+                .flat_map_iter(|t| (0..4).map(move |c| self.subdivide(t, c)))
+                .collect();
+        }
+        tiles
+    }
+
     /// Face coordinates of a point given in the tile's own frame (cells).
     ///
     /// # Example
