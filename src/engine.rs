@@ -2,13 +2,14 @@
 //!
 //! ```text
 //! visit(tile):
-//!     if capacity(level) >= magnitude * bound(tile):      terminal
-//!         d = magnitude * average(tile)
-//!         if code(tile) < d: emit(sample(tile, d / capacity(level)), rank = code / d)
+//!     if capacity(level) >= magnitude * bound(tile) / mean:      terminal
+//!         d = magnitude * average(tile) / mean
+//!         if code(tile) + 1/2 < d: emit(sample(tile, d / capacity(level)), rank = code / d)
 //!     else: visit every child
 //! ```
-//! `magnitude` is the sample count the whole domain would receive at unit
-//! density. Ranks order the output progressively: the samples with rank
+//! `magnitude` is the expected sample count over the whole domain, `mean`
+//! the density's mean over it (dividing first keeps densities anywhere in
+//! 1e-300..1e300, subnormals included, from overflowing). Ranks order the output progressively: the samples with rank
 //! below `s` are those an `s`-times smaller request accepts, so every prefix
 //! of the output is itself a well-spread set. The roots are visited in parallel and
 //! gathered in order, so the output does not depend on the thread count.
@@ -35,7 +36,8 @@ pub struct Sample<P> {
     pub rank: f64,
 }
 
-/// Every sample the tiling accepts at the given magnitude, in root order
+/// Every sample the tiling accepts when `magnitude` samples are expected
+/// over the whole domain, in root order
 /// (not yet ranked).
 ///
 /// # Example
@@ -64,6 +66,7 @@ where
         system,
         density,
         magnitude,
+        mean: density.mean(),
         constant: density.constant(),
     };
     let roots = system.roots();
@@ -85,6 +88,7 @@ struct Walker<'a, S, D: ?Sized> {
     system: &'a S,
     density: &'a D,
     magnitude: f64,
+    mean: f64,
     constant: Option<f64>,
 }
 
@@ -104,18 +108,20 @@ where
                 (self.density.bound(&region), Some(region))
             }
         };
-        let bound = self.magnitude * bound;
+        let bound = self.magnitude * (bound / self.mean);
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
             let d = match (self.constant, &region) {
-                (Some(c), _) => self.magnitude * c,
-                (None, Some(r)) => self.magnitude * self.density.average(r),
+                (Some(_), _) => self.magnitude,
+                (None, Some(r)) => self.magnitude * (self.density.average(r) / self.mean),
                 (None, None) => unreachable!("a region exists whenever the density varies"),
             };
             let code = self.system.code(tile) as f64;
-            if code < d {
+            // a tile's code threshold sits mid-way through its unit of
+            // density, so sparse regions round instead of always keeping code 0
+            if code + 0.5 < d {
                 out.push(Sample {
                     position: self.system.sample(tile, (d / capacity).min(1.0)),
                     rank: code / d,
@@ -175,16 +181,20 @@ where
             return Ok(samples);
         }
     }
-    let mut magnitude = count as f64 / mean;
+    let mut magnitude = count as f64;
     let mut parts = collect_parts(system, density, magnitude);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
-    for _ in 0..16 {
+    for _ in 0..40 {
         let found = total(&parts);
         if !exact || found >= count {
             break;
         }
-        let ratio = count as f64 / found.max(1) as f64;
-        magnitude *= (ratio * 1.01).clamp(1.001, 4.0);
+        let growth = if found == 0 {
+            4.0
+        } else {
+            (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
+        };
+        magnitude *= growth;
         parts = collect_parts(system, density, magnitude);
     }
     if exact && total(&parts) < count {

@@ -184,6 +184,16 @@ impl SphereLut {
             if table.len() != rows * self.bins as usize {
                 return bad(&format!("offset table {level} has the wrong size"));
             }
+            // offsets stay within one cell of the pentomino's 2x3 box
+            let inside = |[x, y]: [i16; 2]| {
+                let (x, y) = (x as f64 / OFFSET_SCALE, y as f64 / OFFSET_SCALE);
+                (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
+            };
+            if let Some(at) = table.iter().position(|&o| !inside(o)) {
+                return bad(&format!(
+                    "offset table {level} entry {at} lies outside the tile's neighbourhood"
+                ));
+            }
         }
         Ok(())
     }

@@ -854,6 +854,7 @@ fn relax(
         .map(|l| bins as u64 * 4u64.pow(l as u32))
         .sum();
     let mut done = 0;
+    let mut previous: Option<Vec<[f64; 2]>> = None;
     for level in 0..options.table_levels as u32 {
         let level_clock = std::time::Instant::now();
         let tiles = tiling.tiles(level);
@@ -870,11 +871,8 @@ fn relax(
             lut.transitions.len()
         };
         // start from the previous level's converged offsets where the row exists
-        let start: Vec<[f64; 2]> = match tables.last() {
-            Some(previous) if !exact && previous.len() == row_count * bins => previous
-                .iter()
-                .map(|o| [o[0] as f64, o[1] as f64])
-                .collect(),
+        let start: Vec<[f64; 2]> = match previous.take() {
+            Some(previous) if !exact && previous.len() == row_count * bins => previous,
             _ => vec![centroid; row_count * bins],
         };
         let mut table = start.clone();
@@ -907,6 +905,7 @@ fn relax(
             .lloyd_seconds
             .push(level_clock.elapsed().as_secs_f64());
         tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
+        previous = Some(table);
     }
     tables
 }
