@@ -17,7 +17,7 @@ const HEIGHT: f64 = 720.0;
 /// ```
 /// use tessera::tiling::sphere::SphereTiling;
 /// let svg = tessera::io::svg::sphere_tiles(&SphereTiling::default(), 0, &[glam::DVec3::X]);
-/// assert!(svg.starts_with("<svg") && svg.matches("<polygon").count() == 240);
+/// assert!(svg.starts_with("<svg") && svg.matches("<polygon").count() >= 240);
 /// ```
 pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -> String {
     let tiles: Vec<SphereTile> = tiling.tiles(level);
@@ -48,15 +48,24 @@ pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -
         }
         unwrap_longitudes(&mut lonlats);
         let grey = 40.0 + 200.0 * tile.code as f64 / capacity;
-        let mut path = String::new();
-        for (lon, lat) in &lonlats {
-            let _ = write!(path, "{:.2},{:.2} ", x_of(*lon), y_of(*lat));
+        // a polygon crossing the antimeridian is drawn on both edges
+        let west = lonlats.iter().map(|l| l.0).fold(f64::INFINITY, f64::min);
+        let east = lonlats
+            .iter()
+            .map(|l| l.0)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let shifts = [(true, 0.0), (west < -180.0, 360.0), (east > 180.0, -360.0)];
+        for (_, shift) in shifts.iter().filter(|s| s.0) {
+            let mut path = String::new();
+            for (lon, lat) in &lonlats {
+                let _ = write!(path, "{:.2},{:.2} ", x_of(lon + shift), y_of(*lat));
+            }
+            let _ = writeln!(
+                svg,
+                r#"<polygon points="{path}" fill="rgb({g},{g},255)" stroke="black" stroke-width="{stroke}"/>"#,
+                g = grey as u8
+            );
         }
-        let _ = writeln!(
-            svg,
-            r#"<polygon points="{path}" fill="rgb({g},{g},255)" stroke="black" stroke-width="{stroke}"/>"#,
-            g = grey as u8
-        );
     }
     let radius = (3.0 / (1 << level) as f64).max(0.6);
     for &p in points {
