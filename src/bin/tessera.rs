@@ -101,6 +101,26 @@ struct TilesArgs {
 enum LutCommand {
     /// Run the offline optimiser and write the table and its provenance.
     Build(LutBuildArgs),
+    /// Find a rep-tile's production rule by exact-cover search and store it.
+    Tiling(LutTilingArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RepTile {
+    /// G-hexomino `X.. / XXX / XX.`, 81-rep (scale 9).
+    Ghexomino,
+    /// P-pentomino `XX / XX / X.`, 4-rep (scale 2), both dissections.
+    Ppentomino,
+}
+
+#[derive(Args)]
+struct LutTilingArgs {
+    /// Which rep-tile.
+    #[arg(value_enum)]
+    tile: RepTile,
+    /// Directory to write `<tile>.rules.json` into.
+    #[arg(long, default_value = "luts")]
+    out_dir: PathBuf,
 }
 
 #[derive(Args)]
@@ -136,6 +156,9 @@ fn main() -> ExitCode {
         Command::Lut {
             command: LutCommand::Build(args),
         } => lut_build(args),
+        Command::Lut {
+            command: LutCommand::Tiling(args),
+        } => lut_tiling(args),
         Command::Metrics(args) => metrics(args),
     };
     match result {
@@ -289,5 +312,39 @@ fn metrics(args: MetricsArgs) -> Result<(), Error> {
             println!("{key:>24} {value}");
         }
     }
+    Ok(())
+}
+
+fn lut_tiling(args: LutTilingArgs) -> Result<(), Error> {
+    use tessera::tiling::polyomino::{Rule, Shape};
+    let (name, shape, scale, limit) = match args.tile {
+        RepTile::Ghexomino => ("ghexomino", Shape::g_hexomino(), 9, 1),
+        RepTile::Ppentomino => ("ppentomino", Shape::p_pentomino(), 2, usize::MAX),
+    };
+    let started = std::time::Instant::now();
+    let rules = Rule::dissections(&shape, scale, limit);
+    let seconds = started.elapsed().as_secs_f64();
+    if rules.is_empty() || !rules.iter().all(|r| r.tiles_parent(&shape)) {
+        return Err(Error::Request(format!("no dissection of the {name} found")));
+    }
+    let file = serde_json::json!({
+        "provenance": {
+            "command": format!("tessera lut tiling {name}"),
+            "search": "exact cover (Algorithm X, fewest-options cell first, natural option order)",
+            "seconds": seconds,
+            "checked": "children cover the enlarged parent cell by cell",
+        },
+        "shape": shape,
+        "rules": rules,
+    });
+    std::fs::create_dir_all(&args.out_dir).map_err(io_error(&args.out_dir))?;
+    let path = args.out_dir.join(format!("{name}.rules.json"));
+    std::fs::write(&path, serde_json::to_string(&file).expect("json") + "\n")
+        .map_err(io_error(&path))?;
+    eprintln!(
+        "wrote {} ({} rule(s), {seconds:.1} s)",
+        path.display(),
+        rules.len()
+    );
     Ok(())
 }

@@ -496,18 +496,19 @@ impl Rule {
         target == covered
     }
 
-    /// The two dissections of the doubled P-pentomino into four P-pentominoes,
-    /// found by exact-cover search (there are exactly two).
+    /// The dissections of `shape` enlarged `scale` times into `scale^2`
+    /// copies of itself (at most `limit`), found by exact-cover search, each
+    /// with its children in a canonical order (sorted by origin, orientation).
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Rule;
-    /// assert_ne!(Rule::p_pentomino_rules()[0], Rule::p_pentomino_rules()[1]);
+    /// use tessera::tiling::polyomino::{Rule, Shape};
+    /// let rules = Rule::dissections(&Shape::p_pentomino(), 2, usize::MAX);
+    /// assert_eq!(rules.len(), 2);
     /// ```
-    pub fn p_pentomino_rules() -> Vec<Rule> {
-        let shape = Shape::p_pentomino();
-        let region = shape.scaled(2).cells().to_vec();
-        let mut found = crate::optimize::exact_cover::tilings(&shape, &region, usize::MAX, 0);
+    pub fn dissections(shape: &Shape, scale: i32, limit: usize) -> Vec<Rule> {
+        let region = shape.scaled(scale).cells().to_vec();
+        let mut found = crate::optimize::exact_cover::tilings(shape, &region, limit, 0);
         for children in &mut found {
             children.sort_by_key(|p| (p.origin, p.orientation));
         }
@@ -518,8 +519,20 @@ impl Rule {
         });
         found
             .into_iter()
-            .map(|children| Rule { scale: 2, children })
+            .map(|children| Rule { scale, children })
             .collect()
+    }
+
+    /// The two dissections of the doubled P-pentomino into four P-pentominoes
+    /// (the search finds exactly two).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::polyomino::Rule;
+    /// assert_ne!(Rule::p_pentomino_rules()[0], Rule::p_pentomino_rules()[1]);
+    /// ```
+    pub fn p_pentomino_rules() -> Vec<Rule> {
+        Rule::dissections(&Shape::p_pentomino(), 2, usize::MAX)
     }
 }
 
