@@ -170,6 +170,14 @@ where
             "the density's mean over the domain is {mean}; it must be positive and finite"
         )));
     }
+    // refuse, rather than abort on, a request whose output cannot be held
+    let mut probe: Vec<Sample<S::Point>> = Vec::new();
+    probe.try_reserve_exact(count).map_err(|_| {
+        Error::Request(format!(
+            "{count} samples do not fit in memory; draw uniform samples with engine::stream"
+        ))
+    })?;
+    drop(probe);
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);

@@ -106,6 +106,10 @@ fn bad_input_gets_a_clear_error_and_no_panic() {
         (vec!["sphere", "-n", "abc"], "abc"),
         (vec!["sphere", "-n", "-5"], "-5"),
         (
+            vec!["sphere", "-n", "100000000000000"],
+            "do not fit in memory",
+        ),
+        (
             vec!["sphere", "-n", "10", "--density", "cap:1,2"],
             "cap:1,2",
         ),
