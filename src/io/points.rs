@@ -161,7 +161,7 @@ pub fn read_points_from(
             )));
         }
         let body = &bytes[20..];
-        if body.len() != count * dims * 8 {
+        if Some(body.len()) != count.checked_mul(dims * 8) {
             return Err(fail(format!(
                 "header announces {count} points but the file holds {} bytes of data",
                 body.len()
