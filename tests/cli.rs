@@ -101,13 +101,36 @@ fn binary_format_is_utk() {
 }
 
 #[test]
+fn large_uniform_requests_stream() {
+    // above 2^24 samples the CLI streams; the header still counts them all
+    let n = (1usize << 24) + 1;
+    let out = tessera(&["sphere", "-n", &n.to_string(), "--format", "bin", "-o", "-"]);
+    assert!(out.status.success());
+    assert_eq!(out.stdout.len(), 20 + 24 * n);
+    assert_eq!(
+        u32::from_le_bytes(out.stdout[12..16].try_into().unwrap()),
+        n as u32
+    );
+}
+
+#[test]
 fn bad_input_gets_a_clear_error_and_no_panic() {
     for (args, needle) in [
         (vec!["sphere", "-n", "abc"], "abc"),
         (vec!["sphere", "-n", "-5"], "-5"),
         (
-            vec!["sphere", "-n", "100000000000000"],
+            vec![
+                "sphere",
+                "-n",
+                "100000000000000",
+                "--density",
+                "cap:0,0,10,5",
+            ],
             "do not fit in memory",
+        ),
+        (
+            vec!["sphere", "-n", "100000000000000", "--format", "bin"],
+            "at most 2^32-1 points",
         ),
         (
             vec!["sphere", "-n", "10", "--density", "cap:1,2"],

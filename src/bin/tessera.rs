@@ -170,6 +170,10 @@ fn main() -> ExitCode {
     }
 }
 
+/// Uniform requests above this many samples stream one at a time (one
+/// thread, O(depth) memory) instead of being generated in parallel in memory.
+const STREAM_ABOVE: usize = 1 << 24;
+
 fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
     if path == Path::new("-") {
         return Ok(Box::new(std::io::BufWriter::new(std::io::stdout().lock())));
@@ -192,14 +196,23 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let format: SphereFormat = args.format.parse()?;
     let density = tessera::density::sphere::parse(&args.density)?;
     let tiling = SphereTiling::default();
-    let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
+    let pdf = |p| engine::pdf(&tiling, &*density, p);
     let mut out = create(&args.output)?;
-    let points = samples.iter().map(|s| s.position);
-    tessera::io::points::write_sphere(&mut out, points, format, |p| {
-        engine::pdf(&tiling, &*density, p)
-    })
-    .and_then(|()| out.flush())
-    .map_err(io_error(&args.output))
+    let written = match engine::stream(&tiling, args.count) {
+        // large uniform requests stream: memory stays O(depth)
+        Some(stream) if density.constant().is_some() && args.count > STREAM_ABOVE => {
+            let points = stream.map(|s| s.position);
+            tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        }
+        _ => {
+            let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
+            let points = samples.iter().map(|s| s.position);
+            tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        }
+    };
+    written
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.output))
 }
 
 fn tiles(args: TilesArgs) -> Result<(), Error> {
