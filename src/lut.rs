@@ -10,11 +10,23 @@ use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 2;
+pub const SPHERE_LUT_VERSION: u32 = 3;
 
-/// Offsets are stored as `i16` multiples of `1 / OFFSET_SCALE` cells
-/// (resolution 2.4e-4 cells, range +-8 cells): half the size of `f32`.
-pub const OFFSET_SCALE: f64 = 4096.0;
+/// Offsets are stored as `i8` multiples of `1 / OFFSET_SCALE` cells from
+/// [`OFFSET_CENTRE`] (resolution 0.025 cells, 0.3 % of the point spacing;
+/// range +-3.2 cells, which holds the pentomino's box dilated by one cell):
+/// a quarter of the size of `f32`, so twice the importance bins fit.
+pub const OFFSET_SCALE: f64 = 40.0;
+
+/// Centre of the P-pentomino's 2x3 bounding box, in its own frame (cells):
+/// the origin of stored offsets.
+pub const OFFSET_CENTRE: [f64; 2] = [1.0, 1.5];
+
+/// Density fractions users ask for most often, each given a bin of its own
+/// so that those requests see no holes: powers of two land on 4/15 or 8/15
+/// of a level's capacity (`240 * 4^k` tiles), HEALPix pixel counts
+/// `12 * 4^k` on 4/5, and `3 * 2^k` on 2/5 or 4/5.
+pub const COMMON_FRACTIONS: [f64; 4] = [4.0 / 15.0, 2.0 / 5.0, 8.0 / 15.0, 4.0 / 5.0];
 
 /// Everything the sphere tile system needs at run time.
 ///
@@ -48,29 +60,42 @@ pub struct SphereLut {
     pub entry_class: Vec<[u32; 4]>,
     /// Neighbourhood-class automaton: `transitions[class][child]`.
     pub transitions: Vec<[u32; 4]>,
-    /// Number of importance bins per structural index.
-    pub bins: u8,
+    /// The density fraction (of a level's capacity) each importance bin
+    /// was optimised for, increasing, the last one 1.
+    pub bin_fractions: Vec<f64>,
     /// Offsets per level (the last one serves every deeper level), indexed
-    /// `index * bins + bin`, in the tile's frame, in cells times
-    /// [`OFFSET_SCALE`].
-    pub tables: Vec<Vec<[i16; 2]>>,
+    /// `index * bins + bin`, in the tile's frame, as cells from
+    /// [`OFFSET_CENTRE`] times [`OFFSET_SCALE`].
+    pub tables: Vec<Vec<[i8; 2]>>,
 }
 
 impl SphereLut {
     /// The importance bin of a density fraction `f` in `(0, 1]` of a level's
-    /// capacity: bins are equally spaced in `log4 f` from 1/4 (bin 0) to 1,
-    /// and `f` goes to the bin at or above it, so the tiles accepted at `f`
-    /// are a subset of those the bin was optimised with (never a crowd).
+    /// capacity: the first bin optimised for `f` or more, so the tiles
+    /// accepted at `f` are a subset of those the bin was optimised with
+    /// (holes at worst, never a crowd).
     ///
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// assert_eq!(lut.bin(1.0), lut.bins as usize - 1);
+    /// assert_eq!(lut.bin(1.0), lut.bin_fractions.len() - 1);
     /// assert_eq!(lut.bin(0.25), 0);
     /// assert_eq!(lut.bin(1e-9), 0);
+    /// assert_eq!(lut.bin_fractions[lut.bin(0.8)], 0.8);
     /// ```
     pub fn bin(&self, fraction: f64) -> usize {
-        bin_of(fraction, self.bins as usize)
+        bin_in(&self.bin_fractions, fraction)
+    }
+
+    /// Number of importance bins.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// assert_eq!(lut.bins(), lut.bin_fractions.len());
+    /// ```
+    pub fn bins(&self) -> usize {
+        self.bin_fractions.len()
     }
 
     /// Decodes a table, checking its version and internal consistency.
@@ -110,21 +135,20 @@ impl SphereLut {
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// let o = lut.offset(0, 0, lut.bins as usize - 1);
+    /// let o = lut.offset(0, 0, lut.bins() - 1);
     /// assert!(tessera::tiling::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
         let table = &self.tables[level.min(self.tables.len() - 1)];
-        let [x, y] = table[index * self.bins as usize + bin];
-        [x as f64 / OFFSET_SCALE, y as f64 / OFFSET_SCALE]
+        dequantise(table[index * self.bins() + bin])
     }
 
-    /// Quantises an offset (cells) for storage.
-    pub(crate) fn quantise(offset: [f64; 2]) -> [i16; 2] {
-        offset.map(|v| {
-            (v * OFFSET_SCALE)
+    /// Quantises an offset (cells, tile frame) for storage.
+    pub(crate) fn quantise(offset: [f64; 2]) -> [i8; 2] {
+        [0, 1].map(|k| {
+            ((offset[k] - OFFSET_CENTRE[k]) * OFFSET_SCALE)
                 .round()
-                .clamp(i16::MIN as f64, i16::MAX as f64) as i16
+                .clamp(i8::MIN as f64, i8::MAX as f64) as i8
         })
     }
 
@@ -157,8 +181,15 @@ impl SphereLut {
         if ranks.iter().enumerate().any(|(i, &r)| r as usize != i) {
             return bad("root ranks must be a permutation of 0..240");
         }
-        if self.exact_levels == 0 || self.bins == 0 {
-            return bad("exact_levels and bins must be positive");
+        if self.exact_levels == 0 {
+            return bad("exact_levels must be positive");
+        }
+        let fractions = &self.bin_fractions;
+        if fractions.last() != Some(&1.0)
+            || !fractions.windows(2).all(|w| w[0] < w[1])
+            || !fractions.iter().all(|&f| f > 0.0)
+        {
+            return bad("bin fractions must increase from above 0 to exactly 1");
         }
         let last_exact = roots << (2 * (self.exact_levels as usize - 1));
         let classes = self.transitions.len();
@@ -181,12 +212,12 @@ impl SphereLut {
             } else {
                 classes
             };
-            if table.len() != rows * self.bins as usize {
+            if table.len() != rows * self.bins() {
                 return bad(&format!("offset table {level} has the wrong size"));
             }
             // offsets stay within one cell of the pentomino's 2x3 box
-            let inside = |[x, y]: [i16; 2]| {
-                let (x, y) = (x as f64 / OFFSET_SCALE, y as f64 / OFFSET_SCALE);
+            let inside = |stored: [i8; 2]| {
+                let [x, y] = dequantise(stored);
                 (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
             };
             if let Some(at) = table.iter().position(|&o| !inside(o)) {
@@ -199,10 +230,9 @@ impl SphereLut {
     }
 }
 
-/// Bin of a density fraction, shared by the run time and the optimiser.
-pub(crate) fn bin_of(fraction: f64, bins: usize) -> usize {
-    let edges: Vec<f64> = (0..bins).map(|b| fraction_of_bin(b, bins)).collect();
-    bin_in(&edges, fraction)
+/// A stored offset in cells, tile frame.
+fn dequantise(stored: [i8; 2]) -> [f64; 2] {
+    [0, 1].map(|k| stored[k] as f64 / OFFSET_SCALE + OFFSET_CENTRE[k])
 }
 
 /// The first bin whose optimised fraction is at or above `fraction` (with a
@@ -214,9 +244,35 @@ pub(crate) fn bin_in(edges: &[f64], fraction: f64) -> usize {
         .unwrap_or(edges.len() - 1)
 }
 
-/// The density fraction an importance bin is optimised for.
-pub(crate) fn fraction_of_bin(bin: usize, bins: usize) -> f64 {
-    4f64.powf(bin as f64 / (bins - 1).max(1) as f64 - 1.0)
+/// The density fractions of `count` importance bins: equally spaced in
+/// `log4 f` from 1/4 to 1, with the grid point nearest each of
+/// [`COMMON_FRACTIONS`] moved onto it (`count >= 6`, so that each has an
+/// interior grid point of its own).
+///
+/// # Example
+/// ```
+/// let f = tessera::lut::bin_fractions(12);
+/// assert_eq!(f.len(), 12);
+/// assert_eq!((f[0], f[11]), (0.25, 1.0));
+/// assert!(f.contains(&0.8) && f.windows(2).all(|w| w[0] < w[1]));
+/// ```
+pub fn bin_fractions(count: usize) -> Vec<f64> {
+    let count = count.max(6);
+    let mut fractions: Vec<f64> = (0..count)
+        .map(|b| 4f64.powf(b as f64 / (count - 1) as f64 - 1.0))
+        .collect();
+    let mut moved = vec![false; count];
+    for common in COMMON_FRACTIONS {
+        let distance = |b: usize| (fractions[b] / common).ln().abs();
+        let nearest = (1..count - 1)
+            .filter(|&b| !moved[b])
+            .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
+            .expect("count >= 6 leaves an interior bin for each common fraction");
+        fractions[nearest] = common;
+        moved[nearest] = true;
+    }
+    fractions.sort_by(f64::total_cmp);
+    fractions
 }
 
 static SPHERE_BYTES: &[u8] = include_bytes!("../luts/sphere.lut");

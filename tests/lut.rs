@@ -22,6 +22,6 @@ fn bad_tables_are_refused_with_a_reason() {
     broken.transitions[0][0] = u32::MAX;
     assert!(err(&broken.to_bytes()).contains("missing class"));
     let mut far = (*sphere_lut()).clone();
-    far.tables[0][0] = [i16::MAX, 0];
+    far.tables[0][0] = [i8::MAX, 0];
     assert!(err(&far.to_bytes()).contains("outside"));
 }

@@ -200,6 +200,52 @@ fn small_bright_caps_are_never_skipped() {
 }
 
 #[test]
+fn common_counts_use_a_bin_optimised_for_exactly_their_density() {
+    // powers of two, HEALPix pixel counts 12 * 4^k and 3 * 2^k: the uniform
+    // request keeps codes 0..N of the first level holding N, and the table
+    // has a bin for exactly that fraction, so the set has no holes
+    let tiling = SphereTiling::default();
+    let lut = tiling.lut();
+    let families = (4..=24)
+        .map(|k| 1u64 << k)
+        .chain((2..=12).map(|k| 12 << (2 * k)))
+        .chain((5..=24).map(|k| 3 << k));
+    for n in families {
+        let level = (0..).find(|&l| tiling.capacity(l) >= n as f64).unwrap();
+        let fraction = n as f64 / tiling.capacity(level);
+        if fraction <= 0.25 {
+            continue; // the level below is full: no holes either
+        }
+        let bin = lut.bin(fraction);
+        assert_relative_eq!(lut.bin_fractions[bin], fraction, max_relative = 1e-12);
+    }
+}
+
+#[test]
+fn uniform_sets_meet_the_quality_floors_against_fibonacci() {
+    // the floors of the flagship issue, measured on the shipped table
+    for n in [3072, 12288] {
+        let points: Vec<DVec3> = Sampler::sphere()
+            .count(n)
+            .generate()
+            .unwrap()
+            .iter()
+            .map(|s| s.position)
+            .collect();
+        let ours = tessera::metrics::sphere_report(&points);
+        let fibonacci =
+            tessera::metrics::sphere_report(&tessera::baselines::spherical_fibonacci(n));
+        assert!(ours.separation >= 2.6, "N = {n}: {ours:?}");
+        assert!(ours.riesz1_normalized <= -1.08, "N = {n}: {ours:?}");
+        let ratio = ours.cap_discrepancy_l2 / fibonacci.cap_discrepancy_l2;
+        assert!(
+            ratio <= 1.3,
+            "N = {n}: cap discrepancy {ratio:.3}x Fibonacci's"
+        );
+    }
+}
+
+#[test]
 fn counts_are_exact_for_awkward_n() {
     for n in [0usize, 1, 2, 3, 239, 241, 1001, 4097] {
         assert_eq!(Sampler::sphere().count(n).generate().unwrap().len(), n);

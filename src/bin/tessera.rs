@@ -132,8 +132,13 @@ struct LutBuildArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Lloyd iterations per level and importance bin.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 32)]
     iterations: usize,
+    /// Importance bins per structural index (6..=64): more bins leave fewer
+    /// holes between optimised densities, and make a larger table and a
+    /// longer build.
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u8).range(6..=64))]
+    bins: u8,
     /// Directory to write `<system>.lut` and `<system>.provenance.json` into.
     #[arg(long, default_value = "luts")]
     out_dir: PathBuf,
@@ -244,6 +249,7 @@ fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
             let options = tessera::optimize::sphere::BuildOptions {
                 seed: args.seed,
                 iterations: args.iterations,
+                bins: args.bins,
                 ..Default::default()
             };
             let bar = ProgressBar::new(1);

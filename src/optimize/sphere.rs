@@ -18,7 +18,7 @@
 use super::exact_cover;
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
-use crate::lut::{fraction_of_bin, SphereLut, SPHERE_LUT_VERSION};
+use crate::lut::{SphereLut, SPHERE_LUT_VERSION};
 use crate::tiling::polyomino::{Orientation, Placement, Rule, Shape};
 use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
 use crate::tiling::TileSystem;
@@ -52,7 +52,8 @@ pub struct BuildOptions {
     pub class_radius: u32,
     /// Number of offset tables; the last serves every deeper level.
     pub table_levels: u8,
-    /// Importance bins per structural index.
+    /// Importance bins per structural index (at least 6; their fractions
+    /// come from [`crate::lut::bin_fractions`]).
     pub bins: u8,
     /// Lloyd iterations per level and bin.
     pub iterations: usize,
@@ -67,8 +68,8 @@ impl Default for BuildOptions {
             class_depth: 6,
             class_radius: 2,
             table_levels: 6,
-            bins: 8,
-            iterations: 16,
+            bins: 12,
+            iterations: 32,
         }
     }
 }
@@ -123,12 +124,12 @@ pub fn build(
     if options.exact_levels == 0
         || options.table_levels <= options.exact_levels
         || options.class_depth < options.exact_levels + 1
-        || options.bins < 2
+        || options.bins < 6
         || options.class_depth > 10
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < exact_levels < table_levels, \
-             exact_levels < class_depth <= 10, bins >= 2)"
+             exact_levels < class_depth <= 10, bins >= 6)"
         )));
     }
     let mut report = BuildReport::default();
@@ -174,7 +175,7 @@ pub fn build(
         exact_levels: 12,
         entry_class: Vec::new(),
         transitions: Vec::new(),
-        bins: options.bins,
+        bin_fractions: crate::lut::bin_fractions(options.bins as usize),
         tables: Vec::new(),
     };
     lut.root_rank = root_ranks(&lut);
@@ -845,11 +846,11 @@ fn relax(
     options: &BuildOptions,
     progress: Progress,
     report: &mut BuildReport,
-) -> Vec<Vec<[i16; 2]>> {
+) -> Vec<Vec<[i8; 2]>> {
     let shape = tiling.shape().clone();
-    let bins = options.bins as usize;
+    let bins = lut.bins();
     let centroid = shape.centroid();
-    let mut tables: Vec<Vec<[i16; 2]>> = Vec::new();
+    let mut tables: Vec<Vec<[i8; 2]>> = Vec::new();
     let total: u64 = (0..options.table_levels as u64)
         .map(|l| bins as u64 * 4u64.pow(l as u32))
         .sum();
@@ -878,7 +879,7 @@ fn relax(
         let mut table = start.clone();
         let mut residual = 0.0;
         for bin in 0..bins {
-            let fraction = fraction_of_bin(bin, bins);
+            let fraction = lut.bin_fractions[bin];
             let (offsets, r) = relax_bin(
                 tiling,
                 &tiles,

@@ -114,8 +114,6 @@ pub struct SphereTiling {
     roots_by_code: Vec<SphereTile>,
     /// `child_of_digit[rule][digit]`: which child carries a digit.
     child_of_digit: [[u8; 4]; 2],
-    /// The density fraction each importance bin was optimised for.
-    bin_fractions: Vec<f64>,
 }
 
 impl Default for SphereTiling {
@@ -140,12 +138,7 @@ impl SphereTiling {
             shape: Shape::p_pentomino(),
             roots_by_code: Vec::new(),
             child_of_digit: [[0; 4]; 2],
-            bin_fractions: Vec::new(),
         };
-        let bins = tiling.lut.bins as usize;
-        tiling.bin_fractions = (0..bins)
-            .map(|b| crate::lut::fraction_of_bin(b, bins))
-            .collect();
         let mut roots = tiling.roots();
         roots.sort_by_key(|t| t.code);
         tiling.roots_by_code = roots;
@@ -251,8 +244,7 @@ impl SphereTiling {
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        let bin = crate::lut::bin_in(&self.bin_fractions, fraction);
-        lut.offset(tile.level as usize, tile.index as usize, bin)
+        lut.offset(tile.level as usize, tile.index as usize, lut.bin(fraction))
     }
 
     /// The shape of every tile.
