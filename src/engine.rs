@@ -4,7 +4,10 @@
 //! visit(tile):
 //!     if capacity(level) >= magnitude * bound(tile) / mean:      terminal
 //!         d = magnitude * average(tile) / mean
-//!         if code(tile) + 1/2 < d: emit(sample(tile, d / capacity(level)), rank = code / d)
+//!         if code(tile) + 1/2 < d:
+//!             p = sample(tile, d / capacity(level))
+//!             if density varies and density(p) == 0: visit every child  (off the support)
+//!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
 //! `magnitude` is the expected sample count over the whole domain, `mean`
@@ -121,13 +124,27 @@ where
             let code = self.system.code(tile) as f64;
             // a tile's code threshold sits mid-way through its unit of
             // density, so sparse regions round instead of always keeping code 0
-            if code + 0.5 < d {
+            if d.is_nan() || code + 0.5 >= d {
+                return;
+            }
+            let position = self.system.sample(tile, (d / capacity).min(1.0));
+            // an offset may carry a sample off the support of a partly lit
+            // tile (a map lit in one pixel): then the tile's children place
+            // it, the one sharing its code (and lit) keeping it
+            let off_support = self.constant.is_none() && {
+                let value = self.density.value(position);
+                value.is_nan() || value <= 0.0
+            };
+            if !off_support {
                 out.push(Sample {
-                    position: self.system.sample(tile, (d / capacity).min(1.0)),
+                    position,
                     rank: code / d,
                 });
+                return;
             }
-            return;
+            if level >= self.system.max_level() {
+                return;
+            }
         }
         for i in 0..self.system.child_count(tile) {
             self.visit(&self.system.child(tile, i), out);
