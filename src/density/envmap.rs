@@ -421,6 +421,29 @@ impl EnvMap {
         Ok(samples)
     }
 
+    /// The world direction at `(u, v)` in `[0, 1)^2` of pixel (column `i`,
+    /// row `j`), uniform in solid angle over the pixel.
+    ///
+    /// # Example
+    /// ```
+    /// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster};
+    /// let map = EnvMap::new(Raster { width: 4, height: 2, values: vec![1.0; 8], bad_pixels: 0 }, Up::Z).unwrap();
+    /// let d = map.direction_in_pixel(1, 0, 0.5, 0.5);
+    /// assert!(d.z > 0.0 && d.x < 0.0 && d.y > 0.0);
+    /// ```
+    pub fn direction_in_pixel(&self, i: usize, j: usize, u: f64, v: f64) -> DVec3 {
+        let (w, h) = (self.pixels.width as f64, self.pixels.height as f64);
+        let phi = TAU * (i as f64 + u) / w;
+        let (a, b) = (j as f64 * PI / h, (j + 1) as f64 * PI / h);
+        // cos(theta) uniform in [cos b, cos a], written as cos a - v (cos a - cos b)
+        // with the difference taken without cancellation
+        let z = a.cos() - v * 2.0 * ((a + b) / 2.0).sin() * ((b - a) / 2.0).sin();
+        let z = z.clamp(-1.0, 1.0);
+        let s = ((1.0 - z) * (1.0 + z)).sqrt();
+        self.up
+            .from_map(DVec3::new(s * phi.cos(), s * phi.sin(), z))
+    }
+
     /// The value in the sampling frame.
     fn at(&self, p: DVec3) -> f64 {
         self.radiance(self.rotation * p)
