@@ -116,12 +116,15 @@ where
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
+            let code = self.system.code(tile) as f64;
+            if code + 0.5 >= bound {
+                return; // not even the bound would keep it: skip the average
+            }
             let d = match (self.constant, &region) {
                 (Some(_), _) => self.magnitude,
                 (None, Some(r)) => self.magnitude * (self.density.average(r) / self.mean),
                 (None, None) => unreachable!("a region exists whenever the density varies"),
             };
-            let code = self.system.code(tile) as f64;
             // a tile's code threshold sits mid-way through its unit of
             // density, so sparse regions round instead of always keeping code 0
             if d.is_nan() || code + 0.5 >= d {

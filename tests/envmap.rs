@@ -420,3 +420,67 @@ fn hostile_files_give_errors_naming_them() {
     let e = message(&good, &strict);
     assert!(e.contains("pixel(s) are negative, NaN or infinite"), "{e}");
 }
+
+#[test]
+fn irradiance_error_is_below_0_4_of_inverse_cdf() {
+    use tessera::baselines::envmap::InverseCdf;
+    use tessera::metrics::irradiance::{estimate, exact, relative_rmse};
+    let dir = temp_dir("irradiance");
+    let normals = tessera::baselines::spherical_fibonacci(64);
+    let (n, seeds) = (4096, 8);
+    for path in sky::write_issue_maps(&dir) {
+        let map = EnvMap::open(&path, &ReadOptions::default(), Up::Z).unwrap();
+        let reference = exact(&map, &normals);
+        let rmse = |samples: &[DVec3]| {
+            let e: Vec<f64> = normals
+                .iter()
+                .map(|&v| estimate(&map, samples, v))
+                .collect();
+            relative_rmse(&e, &reference)
+        };
+        let inverse = InverseCdf::new(&map);
+        let (mut ours, mut iid) = (0.0, 0.0);
+        for seed in 0..seeds {
+            let m = map.with_seed(seed);
+            let s: Vec<DVec3> = m.generate(n).unwrap().iter().map(|s| s.position).collect();
+            ours += rmse(&s).powi(2);
+            iid += rmse(&inverse.samples(n, seed)).powi(2);
+        }
+        let ratio = (ours / iid).sqrt();
+        assert!(
+            ratio <= 0.4,
+            "{}: tessera / inverse-CDF relative RMSE {ratio}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn baselines_follow_the_map() {
+    use tessera::baselines::envmap::{AliasTable, InverseCdf};
+    let dir = temp_dir("baselines");
+    let [_, small] = sky::write_issue_maps(&dir);
+    let map = EnvMap::open(&small, &ReadOptions::default(), Up::Y).unwrap();
+    let expected = bin_masses(&map);
+    let n = 200_000;
+    for (name, samples) in [
+        ("inverse-CDF", InverseCdf::new(&map).samples(n, 9)),
+        ("alias", AliasTable::new(&map).samples(n, 9)),
+    ] {
+        assert!(
+            samples.iter().all(|&d| map.radiance(d) > 0.0),
+            "{name}: off the support"
+        );
+        let mut counts = vec![0usize; 768];
+        for &d in &samples {
+            counts[nside8_bin(d)] += 1;
+        }
+        for (bin, (&c, &e)) in counts.iter().zip(&expected).enumerate() {
+            let e = e * n as f64;
+            assert!(
+                (c as f64 - e).abs() <= 5.0 * e.sqrt().max(1.0),
+                "{name}: bin {bin} {c} vs {e:.1}"
+            );
+        }
+    }
+}

@@ -12,8 +12,9 @@
 //! unit solid angle. Tile bounds take the maximum over every pixel the
 //! tile's bounding cap touches (a cap containing a pole touches every
 //! column) from a max pyramid whose coarser levels are built on first use;
-//! tile averages are a midpoint quadrature over equal-area sub-cells no
-//! larger than a pixel row.
+//! tile averages are the pixel's value when the cap lies in one pixel, else
+//! a midpoint quadrature over equal-area sub-cells about a pixel row across
+//! or smaller.
 //!
 //! ```
 //! use tessera::density::{envmap::{EnvMap, Up}, Density};
@@ -144,13 +145,67 @@ impl Pixels {
         m
     }
 
-    /// Row and column of a Z-up map direction.
+    /// Row and column of a Z-up map direction: a polynomial arctangent,
+    /// and the exact one only within its error of a pixel edge.
     fn pixel_of(&self, m: DVec3) -> (usize, usize) {
-        let (theta, phi) = vec_to_angles(m);
-        let j = ((theta / PI * self.height as f64) as usize).min(self.height - 1);
-        let i = ((phi / TAU * self.width as f64) as usize).min(self.width - 1);
+        let (w, h) = (self.width as f64, self.height as f64);
+        let (theta, phi) = fast_angles(m);
+        let (t, p) = (theta / PI * h, phi / TAU * w);
+        let near_edge = |x: f64, scale: f64| {
+            // x >= 0 here (NaN is caught below): truncation is the floor
+            let f = x - (x as u64) as f64;
+            let margin = 4.0 * FAST_ATAN2_ERROR * scale;
+            f < margin || f > 1.0 - margin
+        };
+        let (t, p) =
+            if near_edge(t, h / PI) || near_edge(p, w / TAU) || !(t.is_finite() && p.is_finite()) {
+                let (theta, phi) = vec_to_angles(m);
+                (theta / PI * h, phi / TAU * w)
+            } else {
+                (t, p)
+            };
+        let j = (t.max(0.0) as usize).min(self.height - 1);
+        let i = (p.max(0.0) as usize).min(self.width - 1);
         (j, i)
     }
+}
+
+/// Largest error (rad) of [`fast_atan2`], checked by a unit test.
+const FAST_ATAN2_ERROR: f64 = 2e-5;
+
+/// `atan2(y, x)` by a degree-11 odd polynomial for the arctangent on
+/// `[0, 1]` and octant reduction; within [`FAST_ATAN2_ERROR`] of the truth.
+fn fast_atan2(y: f64, x: f64) -> f64 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = if ax < ay { (ax, ay) } else { (ay, ax) };
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let a = lo / hi;
+    let s = a * a;
+    let mut r = a
+        * (0.999_977_26
+            + s * (-0.332_623_47
+                + s * (0.193_543_46
+                    + s * (-0.116_432_87 + s * (0.052_653_32 - s * 0.011_721_20)))));
+    if ay > ax {
+        r = std::f64::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 {
+        -r
+    } else {
+        r
+    }
+}
+
+/// `(theta, phi)` of a Z-up direction by [`fast_atan2`], `phi` in `[0, 2 pi)`.
+fn fast_angles(m: DVec3) -> (f64, f64) {
+    let theta = fast_atan2((m.x * m.x + m.y * m.y).sqrt(), m.z);
+    let phi = fast_atan2(m.y, m.x);
+    (theta, if phi < 0.0 { phi + TAU } else { phi })
 }
 
 /// A lat-long HDR environment map as a density on the sphere (see the
@@ -444,6 +499,32 @@ impl EnvMap {
             .from_map(DVec3::new(s * phi.cos(), s * phi.sin(), z))
     }
 
+    /// Rows `j0..=j1` and columns `c0..=c1` (wrapping when `c0 > c1`) of
+    /// every pixel a tile's bounding cap touches; a cap holding a pole
+    /// touches every column.
+    fn touched(&self, region: &SphereRegion) -> (usize, usize, usize, usize) {
+        let px = &*self.pixels;
+        let (w, h) = (px.width as f64, px.height as f64);
+        let m = self.up.to_map(self.rotation * region.center);
+        let (theta, phi) = fast_angles(m);
+        // wider than the cap by the angles' error, so pixel edges never
+        // round inwards
+        let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
+        let j1 = (((theta + r) / PI * h) as usize).min(px.height - 1);
+        let j0 = (((theta - r).max(0.0) / PI * h) as usize).min(j1);
+        if theta - r <= 0.0 || theta + r >= PI || r.sin() >= theta.sin() {
+            return (j0, j1, 0, px.width - 1);
+        }
+        let half = (r.sin() / theta.sin()).asin() + FAST_ATAN2_ERROR;
+        let c0 = ((phi - half) / TAU * w).floor() as i64;
+        let c1 = ((phi + half) / TAU * w).floor() as i64;
+        if c1 - c0 + 1 >= px.width as i64 {
+            return (j0, j1, 0, px.width - 1);
+        }
+        let wrap = |c: i64| c.rem_euclid(px.width as i64) as usize;
+        (j0, j1, wrap(c0), wrap(c1))
+    }
+
     /// The value in the sampling frame.
     fn at(&self, p: DVec3) -> f64 {
         self.radiance(self.rotation * p)
@@ -468,42 +549,25 @@ fn cell_side(cells: &[[f64; 2]; 5]) -> f64 {
 impl Density<SphereRegion> for EnvMap {
     fn bound(&self, region: &SphereRegion) -> f64 {
         let px = &*self.pixels;
-        let (w, h) = (px.width as f64, px.height as f64);
-        let m = self.up.to_map(self.rotation * region.center);
-        let (theta, phi) = vec_to_angles(m);
-        // a hair wider than the cap so pixel edges never round inwards
-        let r = region.radius * (1.0 + 1e-9) + 1e-12;
-        let j0 = ((theta - r).max(0.0) / PI * h) as usize;
-        let j1 = (((theta + r) / PI * h) as usize).min(px.height - 1);
-        let j0 = j0.min(j1);
-        let all = (0, px.width - 1);
-        let columns = if theta - r <= 0.0 || theta + r >= PI || r.sin() >= theta.sin() {
-            all // the cap holds a pole: it touches every column
-        } else {
-            let half = (r.sin() / theta.sin()).asin();
-            let c0 = ((phi - half) / TAU * w).floor() as i64;
-            let c1 = ((phi + half) / TAU * w).floor() as i64;
-            if c1 - c0 + 1 >= px.width as i64 {
-                all
-            } else {
-                (
-                    c0.rem_euclid(px.width as i64) as usize,
-                    c1.rem_euclid(px.width as i64) as usize,
-                )
-            }
-        };
-        match columns {
-            (c0, c1) if c0 <= c1 => px.max_over(j0, j1, c0, c1),
-            (c0, c1) => px
+        match self.touched(region) {
+            (j0, j1, c0, c1) if c0 <= c1 => px.max_over(j0, j1, c0, c1),
+            (j0, j1, c0, c1) => px
                 .max_over(j0, j1, c0, px.width - 1)
                 .max(px.max_over(j0, j1, 0, c1)),
         }
     }
 
     fn average(&self, region: &SphereRegion) -> f64 {
+        let (j0, j1, c0, c1) = self.touched(region);
+        if j0 == j1 && c0 == c1 {
+            // the tile lies in one pixel: its value is the exact average
+            return self.pixels.values[j0 * self.pixels.width + c0];
+        }
         let side = cell_side(&region.cells);
-        // sub-cells about half a pixel row across (face side ~ 1 rad)
-        let n = ((side * self.pixels.height as f64 * 0.7).ceil() as usize).clamp(1, 8);
+        // pixel rows per cell side (a face side is about 1.02 rad)
+        let rows = side * 1.02 / (PI / self.pixels.height as f64);
+        // sub-cells at most about a pixel row across
+        let n = (rows.ceil() as usize).clamp(1, 8);
         let mut sum = 0.0;
         for [cx, cy] in region.cells {
             for a in 0..n {
@@ -523,5 +587,59 @@ impl Density<SphereRegion> for EnvMap {
 
     fn mean(&self) -> f64 {
         self.pixels.integral / (4.0 * PI)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_atan2_is_within_its_error() {
+        let mut rng = SplitMix64::new(1);
+        let mut worst: f64 = 0.0;
+        for k in 0..200_000 {
+            let (y, x) = (rng.next_f64() * 2.0 - 1.0, rng.next_f64() * 2.0 - 1.0);
+            // also the axes and diagonals, and tiny arguments
+            let (y, x) = match k % 5 {
+                0 => (y, 0.0),
+                1 => (0.0, x),
+                2 => (x, x),
+                3 => (y * 1e-300, x),
+                _ => (y, x),
+            };
+            worst = worst.max((fast_atan2(y, x) - y.atan2(x)).abs());
+        }
+        assert!(worst <= FAST_ATAN2_ERROR, "{worst}");
+        assert!(
+            worst > FAST_ATAN2_ERROR / 100.0,
+            "the bound is far too loose: {worst}"
+        );
+    }
+
+    #[test]
+    fn pixel_lookup_agrees_with_exact_angles() {
+        let raster = Raster {
+            width: 1000,
+            height: 500,
+            values: vec![1.0; 500_000],
+            bad_pixels: 0,
+        };
+        let map = EnvMap::new(raster, Up::Z).unwrap();
+        let px = &*map.pixels;
+        let mut rng = SplitMix64::new(2);
+        for _ in 0..200_000 {
+            // points on and near pixel edges
+            let t = ((rng.next_f64() * 500.0).round() + (rng.next_f64() - 0.5) * 1e-3) / 500.0 * PI;
+            let p =
+                ((rng.next_f64() * 1000.0).round() + (rng.next_f64() - 0.5) * 1e-3) / 1000.0 * TAU;
+            let m = crate::healpix::angles_to_vec(t.clamp(0.0, PI), p.rem_euclid(TAU));
+            let (theta, phi) = vec_to_angles(m);
+            let exact = (
+                ((theta / PI * 500.0) as usize).min(499),
+                ((phi / TAU * 1000.0) as usize).min(999),
+            );
+            assert_eq!(px.pixel_of(m), exact, "{m}");
+        }
     }
 }
