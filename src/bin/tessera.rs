@@ -60,10 +60,13 @@ struct MetricsArgs {
 
 #[derive(Args)]
 struct SphereArgs {
-    /// Importance: `uniform` or `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
-    /// density CONTRAST inside the cap, 1 outside).
+    /// Importance: `uniform`, `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
+    /// density CONTRAST inside the cap, 1 outside) or
+    /// `polygon:LON LAT,LON LAT,...;CONTRAST` (GeoJSON-style lon/lat
+    /// polygon). Repeat it to combine regions: the largest contrast of the
+    /// regions containing a point wins, 1 elsewhere.
     #[arg(long, default_value = "uniform")]
-    density: String,
+    density: Vec<String>,
     /// Number of samples (exact unless --expected).
     #[arg(short = 'n', long = "count")]
     count: usize,
@@ -74,7 +77,8 @@ struct SphereArgs {
     #[arg(short, long, default_value = "-")]
     output: PathBuf,
     /// xyz: `x y z` per line; lonlat: `lon lat` degrees; csv: header and a pdf
-    /// column; bin: UTK binary (f64, 3 dimensions).
+    /// column; geojson: a FeatureCollection of Points with a pdf property;
+    /// bin: UTK binary (f64, 3 dimensions).
     #[arg(long, default_value = "xyz")]
     format: String,
     /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
@@ -97,8 +101,8 @@ struct SphereArgs {
     /// deterministic.
     #[arg(long, requires = "map")]
     seed: Option<u64>,
-    /// Print the map's integral and the set's separation, covering radius
-    /// and mesh ratio to standard error.
+    /// Print the set's separation, covering radius and mesh ratio (and a
+    /// map's integral) to standard error.
     #[arg(long)]
     report: bool,
 }
@@ -227,7 +231,7 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     if let Some(path) = &args.map {
         return sphere_map(&args, path, format);
     }
-    let density = tessera::density::sphere::parse(&args.density)?;
+    let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
     let mut out = create(&args.output)?;
@@ -239,7 +243,10 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
         }
         _ => {
             let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
-            let points = samples.iter().map(|s| s.position);
+            let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
+            if args.report {
+                print_report(&points);
+            }
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
     };
@@ -294,12 +301,16 @@ fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<()
         .map_err(io_error(&args.output))
 }
 
-/// Separation, covering radius and mesh ratio of a point set, to standard error.
+/// Separation, covering radius and mesh ratio of a point set (the O(N log N)
+/// measures of `tessera::metrics::sphere`), to standard error.
 fn print_report(points: &[glam::DVec3]) {
-    let r = tessera::metrics::sphere_report(points);
+    use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
     eprintln!(
         "tessera: {} points: separation {:.4}, covering radius x sqrt(N) {:.4}, mesh ratio {:.4}",
-        r.n, r.separation, r.covering_radius, r.mesh_ratio
+        points.len(),
+        separation(points),
+        covering_radius(points),
+        mesh_ratio(points)
     );
 }
 

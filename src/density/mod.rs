@@ -6,6 +6,7 @@
 //! relative: only ratios matter, and the engine scales by the requested count.
 
 pub mod envmap;
+pub mod region;
 pub mod sphere;
 
 /// The geometry a density sees of a tile.
