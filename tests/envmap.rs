@@ -484,3 +484,90 @@ fn baselines_follow_the_map() {
         }
     }
 }
+
+fn tessera(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(args)
+        .output()
+        .expect("run tessera")
+}
+
+#[test]
+fn command_line_samples_maps_with_pdfs() {
+    let dir = temp_dir("cli");
+    let [_, small] = sky::write_issue_maps(&dir);
+    let map_arg = small.to_str().unwrap();
+    let out = tessera(&[
+        "sphere", "--map", map_arg, "-n", "500", "--format", "csv", "--report",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // one warning with the count, the integral, the report
+    assert_eq!(stderr.matches("warning").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("pixel(s) treated as 0") && stderr.contains("integral"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("mesh ratio"), "{stderr}");
+    let map = EnvMap::open(&small, &ReadOptions::default(), Up::Z).unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 500);
+    for r in &rows {
+        let d = DVec3::new(r[0], r[1], r[2]);
+        approx::assert_relative_eq!(r[5], map.pdf(d), max_relative = 1e-12);
+        assert!(r[5] > 0.0);
+    }
+    // deterministic without a seed, different with one, same for the same seed
+    let run = |extra: &[&str]| {
+        let mut args = vec!["sphere", "--map", map_arg, "-n", "50"];
+        args.extend_from_slice(extra);
+        tessera(&args).stdout
+    };
+    assert_eq!(run(&[]), run(&[]));
+    assert_eq!(run(&["--seed", "4"]), run(&["--seed", "4"]));
+    assert_ne!(run(&["--seed", "4"]), run(&[]));
+    // Y-up maps: the sun moves from phi = atan2(y, x) to atan2(x, z)
+    let y_up = run(&["--up", "y"]);
+    assert!(!y_up.is_empty() && y_up != run(&[]));
+    // --strict, a non-2:1 map (warning), missing files, bad channels
+    let strict = tessera(&["sphere", "--map", map_arg, "-n", "5", "--strict"]);
+    assert_eq!(strict.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&strict.stderr).contains(map_arg));
+    let square = dir.join("square.exr");
+    sky::write_exr(
+        &square,
+        16,
+        16,
+        &vec![[1.0; 3]; 256],
+        false,
+        false,
+        exr::prelude::Compression::Uncompressed,
+    );
+    let out = tessera(&["sphere", "--map", square.to_str().unwrap(), "-n", "5"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a 2:1"));
+    let out = tessera(&["sphere", "--map", "/no/such/map.exr", "-n", "5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/map.exr"));
+    let out = tessera(&["sphere", "--map", map_arg, "--channel", "Q", "-n", "5"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no channel named 'Q'"));
+    let out = tessera(&[
+        "sphere",
+        "--map",
+        map_arg,
+        "--density",
+        "uniform",
+        "-n",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
