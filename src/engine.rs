@@ -1,7 +1,8 @@
 //! The adaptive recursion shared by every tile system.
 //!
 //! ```text
-//! visit(tile):
+//! visit(tile, b = the parent's scaled bound, which bounds the tile too):
+//!     if capacity(level) >= b and code(tile) + 1/2 >= b: return   (rejected unseen)
 //!     if capacity(level) >= magnitude * bound(tile) / mean:      terminal
 //!         d = magnitude * average(tile) / mean
 //!         if code(tile) + 1/2 < d:
@@ -81,7 +82,7 @@ where
         .par_iter()
         .map(|root| {
             let mut out = Vec::with_capacity(share);
-            walker.visit(root, &mut out);
+            walker.visit(root, f64::INFINITY, &mut out);
             out
         })
         .collect()
@@ -101,9 +102,15 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    fn visit(&self, tile: &S::Tile, out: &mut Vec<Sample<S::Point>>) {
+    /// `parent_bound`: the parent's scaled bound, which bounds this tile
+    /// too: a tile it already makes terminal and rejects is skipped before
+    /// its region and bound are computed.
+    fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
         let capacity = self.system.capacity(level);
+        if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
+            return;
+        }
         let (bound, region) = match self.constant {
             Some(c) => (c, None),
             None => {
@@ -150,7 +157,7 @@ where
             }
         }
         for i in 0..self.system.child_count(tile) {
-            self.visit(&self.system.child(tile, i), out);
+            self.visit(&self.system.child(tile, i), bound, out);
         }
     }
 }
