@@ -12,10 +12,26 @@ use std::path::{Path, PathBuf};
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::io::image::{read_raster, Raster, ReadOptions};
 
-fn temp_dir(name: &str) -> PathBuf {
+/// A scratch directory removed when dropped.
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.0).ok();
+    }
+}
+
+fn temp_dir(name: &str) -> TempDir {
     let dir = std::env::temp_dir().join(format!("tessera-envmap-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir
+    TempDir(dir)
 }
 
 /// Map pixel (column, row) of a world direction, by the documented convention.

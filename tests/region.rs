@@ -121,4 +121,5 @@ fn geojson_round_trips_through_the_command_line() {
     assert_eq!(points.len(), 300);
     let p = DVec3::new(points[0][0], points[0][1], points[0][2]);
     assert!((p.length() - 1.0).abs() < 1e-12);
+    std::fs::remove_dir_all(&dir).ok();
 }
