@@ -8,7 +8,8 @@
 //! a 10-degree cap around Iceland 36 times denser. It prints the minimum
 //! distance within each density level in units of the local spacing, and
 //! the whole set's separation, covering radius and mesh ratio next to a
-//! uniform (spherical Fibonacci) set of the same size.
+//! uniform (spherical Fibonacci) set of the same size, and the local
+//! separation near and away from the edge of a single refined cap.
 
 use glam::DVec3;
 use tessera::baselines::spherical_fibonacci;
@@ -51,6 +52,30 @@ fn main() -> Result<(), tessera::Error> {
             separation(set),
             covering_radius(set),
             mesh_ratio(set)
+        );
+    }
+    // where the close pairs are: a single cap, measured outside it and
+    // beyond 10 degrees from its edge
+    let cap = Regions::parse(&["cap:0,90,30,16"])?;
+    let set: Vec<DVec3> = Sampler::sphere()
+        .density(cap)
+        .count(n)
+        .generate()?
+        .iter()
+        .map(|s| s.position)
+        .collect();
+    for (name, edge_deg) in [
+        ("outside the cap", 30.0f64),
+        ("beyond 10 deg of its edge", 40.0),
+    ] {
+        let z = edge_deg.to_radians().cos();
+        let subset: Vec<DVec3> = set.iter().copied().filter(|p| p.z < z).collect();
+        let area = 2.0 * std::f64::consts::PI * (1.0 + z);
+        let local = separation(&subset) / (subset.len() as f64).sqrt()
+            * (subset.len() as f64 * 4.0 * std::f64::consts::PI / area).sqrt();
+        println!(
+            "cap:0,90,30,16, {name}: {} points, local separation {local:.3}",
+            subset.len()
         );
     }
     let tiling = sampler.system();
