@@ -306,7 +306,9 @@ impl EnvMap {
     /// The same map sampled in a uniformly random rotated frame (Shoemake's
     /// uniform quaternion from `seed`): estimates from different seeds are
     /// independent and unbiased, and can be averaged. Without it sampling
-    /// is deterministic.
+    /// is deterministic. [`EnvMap::generate`] returns world directions; a
+    /// generic `Sampler` or `engine` call returns sampling-frame directions,
+    /// which [`EnvMap::to_world`] maps to the world.
     ///
     /// # Example
     /// ```

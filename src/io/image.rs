@@ -191,11 +191,17 @@ pub fn read_raster(path: &Path, options: &ReadOptions) -> Result<Raster, Error> 
         }
         &magic[..n]
     };
+    // the decoders are third-party code fed hostile bytes: a panic in one
+    // becomes an error naming the file
+    let guarded = |decode: &dyn Fn() -> Result<(usize, usize, Vec<Channel>, bool), String>| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
+            .unwrap_or_else(|_| Err("the decoder failed on this file".into()))
+            .map_err(fail)
+    };
     let (width, height, channels, srgb) = if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        let (w, h, c) = read_exr(path).map_err(fail)?;
-        (w, h, c, false)
+        guarded(&|| read_exr(path).map(|(w, h, c)| (w, h, c, false)))?
     } else if head.starts_with(b"#?") || head.starts_with(b"\x89PNG") {
-        read_with_image_crate(path).map_err(fail)?
+        guarded(&|| read_with_image_crate(path))?
     } else if head.is_empty() {
         return Err(fail("the file is empty".into()));
     } else {
