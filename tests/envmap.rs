@@ -587,3 +587,56 @@ fn command_line_samples_maps_with_pdfs() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Sparse maps: mostly zero, a few lit pixels (some huge, some tiny),
+    /// and hostile values that must count as zero.
+    fn sparse_map() -> impl Strategy<Value = (usize, usize, Vec<f64>)> {
+        (1usize..24, 1usize..12).prop_flat_map(|(w, h)| {
+            let pixel = prop_oneof![
+                6 => Just(0.0),
+                2 => 1e-3f64..1e3,
+                1 => Just(1e30),
+                1 => Just(f64::NAN),
+                1 => Just(-5.0),
+                1 => Just(f64::INFINITY),
+            ];
+            (Just(w), Just(h), proptest::collection::vec(pixel, w * h))
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+        #[test]
+        fn samples_stay_on_the_support((w, h, values) in sparse_map(), n in 1usize..300, seed in proptest::option::of(any::<u64>()), y_up in any::<bool>()) {
+            let Ok(raster) = Raster::from_values("prop", w, h, values, false) else {
+                return Ok(()); // nothing lit: refused, as it must be
+            };
+            let up = if y_up { Up::Y } else { Up::Z };
+            let map = EnvMap::new(raster, up).unwrap();
+            let map = seed.map_or(map.clone(), |s| map.with_seed(s));
+            let samples = map.generate(n).unwrap();
+            prop_assert_eq!(samples.len(), n);
+            for s in &samples {
+                prop_assert!(map.radiance(s.position) > 0.0, "sample off the support at {}", s.position);
+                prop_assert!((s.position.length() - 1.0).abs() < 1e-9);
+            }
+        }
+
+        #[test]
+        fn exr_bytes_never_panic(body in proptest::collection::vec(any::<u8>(), 0..400)) {
+            let dir = temp_dir("fuzz");
+            let path = dir.join("fuzz.exr");
+            let mut bytes = vec![0x76, 0x2f, 0x31, 0x01];
+            bytes.extend(body);
+            std::fs::write(&path, &bytes).unwrap();
+            if let Err(e) = read_raster(&path, &ReadOptions::default()) {
+                prop_assert!(e.to_string().contains("fuzz.exr"));
+            }
+        }
+    }
+}
