@@ -28,7 +28,7 @@
 
 use super::Density;
 use crate::baselines::SplitMix64;
-use crate::healpix::{vec_to_angles, FacePoint};
+use crate::healpix::FacePoint;
 use crate::io::image::{read_raster, Raster, ReadOptions};
 use crate::tiling::sphere::SphereRegion;
 use crate::Error;
@@ -95,6 +95,7 @@ struct Pixels {
     integral: f64,
     /// Level `l >= 1` holds the maximum over `2^l x 2^l` pixel blocks.
     max_levels: Vec<OnceLock<Vec<f64>>>,
+    edges: Edges,
 }
 
 impl Pixels {
@@ -145,28 +146,106 @@ impl Pixels {
         m
     }
 
-    /// Row and column of a Z-up map direction: a polynomial arctangent,
-    /// and the exact one only within its error of a pixel edge.
+    /// Row and column of a Z-up map direction, without trigonometry: a
+    /// bucket table gives the first candidate and comparisons with the
+    /// exact edges (cosines of row edges, pseudo-angles of column edges)
+    /// settle it.
     fn pixel_of(&self, m: DVec3) -> (usize, usize) {
-        let (w, h) = (self.width as f64, self.height as f64);
-        let (theta, phi) = fast_angles(m);
-        let (t, p) = (theta / PI * h, phi / TAU * w);
-        let near_edge = |x: f64, scale: f64| {
-            // x >= 0 here (NaN is caught below): truncation is the floor
-            let f = x - (x as u64) as f64;
-            let margin = 4.0 * FAST_ATAN2_ERROR * scale;
-            f < margin || f > 1.0 - margin
-        };
-        let (t, p) =
-            if near_edge(t, h / PI) || near_edge(p, w / TAU) || !(t.is_finite() && p.is_finite()) {
-                let (theta, phi) = vec_to_angles(m);
-                (theta / PI * h, phi / TAU * w)
-            } else {
-                (t, p)
-            };
-        let j = (t.max(0.0) as usize).min(self.height - 1);
-        let i = (p.max(0.0) as usize).min(self.width - 1);
-        (j, i)
+        let z = m.z / m.length();
+        let (j, i) = (self.edges.row(z), self.edges.column(m.x, m.y));
+        (j.min(self.height - 1), i.min(self.width - 1))
+    }
+}
+
+/// Pixel edges as trigonometry-free keys, with bucket tables into them.
+struct Edges {
+    /// `cos(j pi / H)` for `j = 0..=H` (decreasing).
+    row_cos: Vec<f64>,
+    /// For each of `4H` equal buckets of `z` in `[-1, 1]`: the row of its top.
+    row_start: Vec<u32>,
+    /// [`pseudo_angle`] of `phi = 2 pi i / W` for `i = 0..=W` (increasing, 0 to 4).
+    col_key: Vec<f64>,
+    /// For each of `4W` equal buckets of the pseudo-angle: its first column.
+    col_start: Vec<u32>,
+}
+
+/// A trigonometry-free angle in `[0, 4)` increasing with `phi = atan2(y, x)`
+/// (one unit per quadrant); 0 for the zero vector.
+fn pseudo_angle(x: f64, y: f64) -> f64 {
+    let a = if y >= 0.0 {
+        if x > 0.0 {
+            y / (x + y)
+        } else {
+            1.0 + (-x) / (y - x)
+        }
+    } else if x <= 0.0 {
+        2.0 + (-y) / (-x - y)
+    } else {
+        3.0 + x / (x - y)
+    };
+    if a.is_nan() || a >= 4.0 {
+        0.0
+    } else {
+        a
+    }
+}
+
+impl Edges {
+    fn new(width: usize, height: usize) -> Self {
+        let row_cos: Vec<f64> = (0..=height)
+            .map(|j| (j as f64 * PI / height as f64).cos())
+            .collect();
+        // number of edges k in 1..H with row_cos[k] >= z: the row of z
+        let row_exact = |z: f64| row_cos[1..height].partition_point(|&c| c >= z);
+        let buckets = 4 * height;
+        let row_start = (0..buckets)
+            .map(|b| row_exact((-1.0 + 2.0 * (b + 1) as f64 / buckets as f64).min(1.0)) as u32)
+            .collect();
+        let mut col_key: Vec<f64> = (0..=width)
+            .map(|i| {
+                let phi = TAU * i as f64 / width as f64;
+                pseudo_angle(phi.cos(), phi.sin())
+            })
+            .collect();
+        col_key[0] = 0.0;
+        col_key[width] = 4.0;
+        let buckets = 4 * width;
+        let col_start = (0..buckets)
+            .map(|b| {
+                let key = 4.0 * b as f64 / buckets as f64;
+                (col_key[1..width].partition_point(|&k| k <= key)) as u32
+            })
+            .collect();
+        Edges {
+            row_cos,
+            row_start,
+            col_key,
+            col_start,
+        }
+    }
+
+    fn row(&self, z: f64) -> usize {
+        let buckets = self.row_start.len();
+        let b = (((z + 1.0) * 0.5 * buckets as f64) as usize).min(buckets - 1);
+        // one row back in case rounding put z a hair above its bucket
+        let mut j = (self.row_start[b] as usize).saturating_sub(1);
+        let last = self.row_cos.len() - 2;
+        while j < last && self.row_cos[j + 1] >= z {
+            j += 1;
+        }
+        j
+    }
+
+    fn column(&self, x: f64, y: f64) -> usize {
+        let key = pseudo_angle(x, y);
+        let buckets = self.col_start.len();
+        let b = ((key * 0.25 * buckets as f64) as usize).min(buckets - 1);
+        let mut i = (self.col_start[b] as usize).saturating_sub(1);
+        let last = self.col_key.len() - 2;
+        while i < last && self.col_key[i + 1] <= key {
+            i += 1;
+        }
+        i
     }
 }
 
@@ -281,6 +360,7 @@ impl EnvMap {
                 row_solid_angle,
                 integral,
                 max_levels: (0..levels).map(|_| OnceLock::new()).collect(),
+                edges: Edges::new(w, h),
             }),
             up,
             rotation: DMat3::IDENTITY,
@@ -514,10 +594,19 @@ impl EnvMap {
         let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
         let j1 = (((theta + r) / PI * h) as usize).min(px.height - 1);
         let j0 = (((theta - r).max(0.0) / PI * h) as usize).min(j1);
-        if theta - r <= 0.0 || theta + r >= PI || r.sin() >= theta.sin() {
+        // sin(theta) of the unit vector without trigonometry, a hair low;
+        // r >= sin r, so `s` bounds sin r / sin theta from above
+        let sin_theta = (m.x * m.x + m.y * m.y).sqrt() * (1.0 - 1e-12);
+        let s = r / sin_theta;
+        if theta - r <= 0.0 || theta + r >= PI || s >= 1.0 || s.is_nan() {
             return (j0, j1, 0, px.width - 1);
         }
-        let half = (r.sin() / theta.sin()).asin() + FAST_ATAN2_ERROR;
+        // asin(s) <= s + s^3 / 5 for s <= 0.1 (its series is s + s^3/6 + ...)
+        let half = if s <= 0.1 {
+            s + s * s * s / 5.0
+        } else {
+            s.asin()
+        } + FAST_ATAN2_ERROR;
         let c0 = ((phi - half) / TAU * w).floor() as i64;
         let c1 = ((phi + half) / TAU * w).floor() as i64;
         if c1 - c0 + 1 >= px.width as i64 {
@@ -595,6 +684,7 @@ impl Density<SphereRegion> for EnvMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::healpix::vec_to_angles;
 
     #[test]
     fn fast_atan2_is_within_its_error() {
@@ -636,6 +726,9 @@ mod tests {
             let p =
                 ((rng.next_f64() * 1000.0).round() + (rng.next_f64() - 0.5) * 1e-3) / 1000.0 * TAU;
             let m = crate::healpix::angles_to_vec(t.clamp(0.0, PI), p.rem_euclid(TAU));
+            if m.x == 0.0 && m.y == 0.0 {
+                continue; // a pole: every column meets there
+            }
             let (theta, phi) = vec_to_angles(m);
             let exact = (
                 ((theta / PI * 500.0) as usize).min(499),
