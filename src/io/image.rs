@@ -19,6 +19,11 @@ use std::path::Path;
 
 /// Largest raster read (pixels): refuses headers that would allocate
 /// gigabytes before any pixel is decoded.
+///
+/// # Example
+/// ```
+/// assert!(tessera::io::image::MAX_PIXELS >= 16384 * 8192);
+/// ```
 pub const MAX_PIXELS: usize = 1 << 28;
 
 /// How to turn a file into importance values.
