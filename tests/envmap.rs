@@ -228,7 +228,7 @@ fn seeds_give_unbiased_independent_estimates() {
         .collect();
     let mean = estimates.iter().sum::<f64>() / estimates.len() as f64;
     // samples in tiles straddling the support's edge lean inwards: a bias
-    // of about 0.5 % at this N (1 % at N = 256), shrinking as 1/sqrt(N)
+    // that shrinks as 1/sqrt(N)
     assert!((mean - exact).abs() < 0.01 * exact, "{mean} vs {exact}");
     assert!(estimates.windows(2).all(|w| w[0] != w[1]));
     // deterministic without a seed
