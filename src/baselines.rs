@@ -10,6 +10,8 @@
 //! assert_eq!(jittered_grid_2d(3, 0).len(), 9);
 //! ```
 
+pub mod envmap;
+
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
 

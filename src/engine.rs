@@ -1,10 +1,14 @@
 //! The adaptive recursion shared by every tile system.
 //!
 //! ```text
-//! visit(tile):
+//! visit(tile, b = the parent's scaled bound, which bounds the tile too):
+//!     if capacity(level) >= b and code(tile) + 1/2 >= b: return   (rejected unseen)
 //!     if capacity(level) >= magnitude * bound(tile) / mean:      terminal
 //!         d = magnitude * average(tile) / mean
-//!         if code(tile) + 1/2 < d: emit(sample(tile, d / capacity(level)), rank = code / d)
+//!         if code(tile) + 1/2 < d:
+//!             p = sample(tile, d / capacity(level))
+//!             if density varies and density(p) == 0: visit every child  (off the support)
+//!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
 //! `magnitude` is the expected sample count over the whole domain, `mean`
@@ -78,7 +82,7 @@ where
         .par_iter()
         .map(|root| {
             let mut out = Vec::with_capacity(share);
-            walker.visit(root, &mut out);
+            walker.visit(root, f64::INFINITY, &mut out);
             out
         })
         .collect()
@@ -98,9 +102,15 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    fn visit(&self, tile: &S::Tile, out: &mut Vec<Sample<S::Point>>) {
+    /// `parent_bound`: the parent's scaled bound, which bounds this tile
+    /// too: a tile it already makes terminal and rejects is skipped before
+    /// its region and bound are computed.
+    fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
         let capacity = self.system.capacity(level);
+        if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
+            return;
+        }
         let (bound, region) = match self.constant {
             Some(c) => (c, None),
             None => {
@@ -113,24 +123,41 @@ where
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
+            let code = self.system.code(tile) as f64;
+            if code + 0.5 >= bound {
+                return; // not even the bound would keep it: skip the average
+            }
             let d = match (self.constant, &region) {
                 (Some(_), _) => self.magnitude,
                 (None, Some(r)) => self.magnitude * (self.density.average(r) / self.mean),
                 (None, None) => unreachable!("a region exists whenever the density varies"),
             };
-            let code = self.system.code(tile) as f64;
             // a tile's code threshold sits mid-way through its unit of
             // density, so sparse regions round instead of always keeping code 0
-            if code + 0.5 < d {
+            if d.is_nan() || code + 0.5 >= d {
+                return;
+            }
+            let position = self.system.sample(tile, (d / capacity).min(1.0));
+            // an offset may carry a sample off the support of a partly lit
+            // tile (a map lit in one pixel): then the tile's children place
+            // it, the one sharing its code (and lit) keeping it
+            let off_support = self.constant.is_none() && {
+                let value = self.density.value(position);
+                value.is_nan() || value <= 0.0
+            };
+            if !off_support {
                 out.push(Sample {
-                    position: self.system.sample(tile, (d / capacity).min(1.0)),
+                    position,
                     rank: code / d,
                 });
+                return;
             }
-            return;
+            if level >= self.system.max_level() {
+                return;
+            }
         }
         for i in 0..self.system.child_count(tile) {
-            self.visit(&self.system.child(tile, i), out);
+            self.visit(&self.system.child(tile, i), bound, out);
         }
     }
 }

@@ -124,6 +124,18 @@ where
         engine::pdf(&self.system, &self.density, point)
     }
 
+    /// The pdfs of generated samples, computed only when asked for.
+    ///
+    /// # Example
+    /// ```
+    /// let sampler = tessera::Sampler::sphere().count(4);
+    /// let pdfs = sampler.pdfs(&sampler.generate().unwrap());
+    /// assert!(pdfs.iter().all(|p| (p * 4.0 * std::f64::consts::PI - 1.0).abs() < 1e-12));
+    /// ```
+    pub fn pdfs(&self, samples: &[Sample<S::Point>]) -> Vec<f64> {
+        samples.iter().map(|s| self.pdf(s.position)).collect()
+    }
+
     /// The tile system.
     ///
     /// # Example

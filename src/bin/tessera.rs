@@ -60,10 +60,13 @@ struct MetricsArgs {
 
 #[derive(Args)]
 struct SphereArgs {
-    /// Importance: `uniform` or `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
-    /// density CONTRAST inside the cap, 1 outside).
+    /// Importance: `uniform`, `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
+    /// density CONTRAST inside the cap, 1 outside) or
+    /// `polygon:LON LAT,LON LAT,...;CONTRAST` (GeoJSON-style lon/lat
+    /// polygon). Repeat it to combine regions: the largest contrast of the
+    /// regions containing a point wins, 1 elsewhere.
     #[arg(long, default_value = "uniform")]
-    density: String,
+    density: Vec<String>,
     /// Number of samples (exact unless --expected).
     #[arg(short = 'n', long = "count")]
     count: usize,
@@ -74,9 +77,40 @@ struct SphereArgs {
     #[arg(short, long, default_value = "-")]
     output: PathBuf,
     /// xyz: `x y z` per line; lonlat: `lon lat` degrees; csv: header and a pdf
-    /// column; bin: UTK binary (f64, 3 dimensions).
+    /// column; geojson: a FeatureCollection of Points with a pdf property;
+    /// bin: UTK binary (f64, 3 dimensions).
     #[arg(long, default_value = "xyz")]
     format: String,
+    /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
+    /// luminance per unit solid angle, constant per pixel. Replaces --density.
+    #[arg(long, conflicts_with = "density")]
+    map: Option<PathBuf>,
+    /// Use this channel of the map (e.g. R, Y) instead of Rec.709 luminance.
+    #[arg(long, requires = "map")]
+    channel: Option<String>,
+    /// The map's up axis: z (column i covers phi = atan2(y, x)) or y
+    /// (directions (x, y, z) are looked up as (z, x, y)).
+    #[arg(long, value_enum, default_value = "z", requires = "map")]
+    up: UpAxis,
+    /// Refuse maps with negative, NaN or infinite pixels (default: count
+    /// them, warn once and treat them as 0).
+    #[arg(long, requires = "map")]
+    strict: bool,
+    /// Sample in a uniformly random rotated frame drawn from this seed
+    /// (unbiased; average estimates over seeds). Without it the output is
+    /// deterministic.
+    #[arg(long, requires = "map")]
+    seed: Option<u64>,
+    /// Print the set's separation, covering radius and mesh ratio (and a
+    /// map's integral) to standard error.
+    #[arg(long)]
+    report: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum UpAxis {
+    Z,
+    Y,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -199,7 +233,10 @@ fn io_error(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
 
 fn sphere(args: SphereArgs) -> Result<(), Error> {
     let format: SphereFormat = args.format.parse()?;
-    let density = tessera::density::sphere::parse(&args.density)?;
+    if let Some(path) = &args.map {
+        return sphere_map(&args, path, format);
+    }
+    let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
     let mut out = create(&args.output)?;
@@ -211,13 +248,75 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
         }
         _ => {
             let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
-            let points = samples.iter().map(|s| s.position);
+            let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
+            if args.report {
+                print_report(&points);
+            }
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
     };
     written
         .and_then(|()| out.flush())
         .map_err(io_error(&args.output))
+}
+
+fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<(), Error> {
+    use tessera::density::envmap::{EnvMap, Up};
+    let options = tessera::io::image::ReadOptions {
+        channel: args.channel.clone(),
+        strict: args.strict,
+        ..Default::default()
+    };
+    let raster = tessera::io::image::read_raster(path, &options)?;
+    let name = path.display();
+    if raster.bad_pixels > 0 {
+        eprintln!(
+            "tessera: warning: {name}: {} negative, NaN or infinite pixel(s) treated as 0 (--strict refuses them)",
+            raster.bad_pixels
+        );
+    }
+    if raster.width != 2 * raster.height {
+        eprintln!(
+            "tessera: warning: {name}: {}x{} is not a 2:1 lat-long map; sampling it as one",
+            raster.width, raster.height
+        );
+    }
+    let up = match args.up {
+        UpAxis::Z => Up::Z,
+        UpAxis::Y => Up::Y,
+    };
+    let map = EnvMap::new(raster, up).map_err(|e| Error::File {
+        path: path.into(),
+        reason: e.to_string(),
+    })?;
+    let map = match args.seed {
+        Some(seed) => map.with_seed(seed),
+        None => map,
+    };
+    let tiling = SphereTiling::default();
+    let samples = engine::generate(&tiling, &map, args.count, !args.expected)?;
+    let points: Vec<glam::DVec3> = samples.iter().map(|s| map.to_world(s.position)).collect();
+    if args.report {
+        eprintln!("tessera: {name}: integral {} (value x sr)", map.integral());
+        print_report(&points);
+    }
+    let mut out = create(&args.output)?;
+    tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.output))
+}
+
+/// Separation, covering radius and mesh ratio of a point set (the O(N log N)
+/// measures of `tessera::metrics::sphere`), to standard error.
+fn print_report(points: &[glam::DVec3]) {
+    use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
+    eprintln!(
+        "tessera: {} points: separation {:.4}, covering radius x sqrt(N) {:.4}, mesh ratio {:.4}",
+        points.len(),
+        separation(points),
+        covering_radius(points),
+        mesh_ratio(points)
+    );
 }
 
 fn tiles(args: TilesArgs) -> Result<(), Error> {

@@ -5,6 +5,8 @@
 //! be skipped) and an average (to threshold the tile's code). Values are
 //! relative: only ratios matter, and the engine scales by the requested count.
 
+pub mod envmap;
+pub mod region;
 pub mod sphere;
 
 /// The geometry a density sees of a tile.

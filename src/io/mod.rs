@@ -1,4 +1,5 @@
-//! Point-set formats (UTK-style text and binary) and drawings.
+//! Point-set formats (UTK-style text and binary), drawings and raster readers.
 
+pub mod image;
 pub mod points;
 pub mod svg;

@@ -30,6 +30,9 @@ pub enum SphereFormat {
     LonLat,
     /// CSV with a header `x,y,z,lon,lat,pdf`.
     Csv,
+    /// GeoJSON (RFC 7946): a FeatureCollection of Points `[lon, lat]` in
+    /// degrees, each with a `pdf` property.
+    GeoJson,
     /// UTK binary, 3 dimensions.
     Bin,
 }
@@ -41,9 +44,10 @@ impl std::str::FromStr for SphereFormat {
             "xyz" | "txt" => Ok(SphereFormat::Xyz),
             "lonlat" => Ok(SphereFormat::LonLat),
             "csv" => Ok(SphereFormat::Csv),
+            "geojson" => Ok(SphereFormat::GeoJson),
             "bin" => Ok(SphereFormat::Bin),
             other => Err(Error::Request(format!(
-                "unknown format '{other}'; expected xyz, lonlat, csv or bin"
+                "unknown format '{other}'; expected xyz, lonlat, csv, geojson or bin"
             ))),
         }
     }
@@ -68,7 +72,8 @@ pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std
     out.write_all(&(dims as u32).to_le_bytes())
 }
 
-/// Writes sphere points in the given format; `pdf` is asked only for CSV.
+/// Writes sphere points in the given format; `pdf` is asked only for CSV
+/// and GeoJSON.
 ///
 /// # Example
 /// ```
@@ -107,6 +112,19 @@ where
                 writeln!(out, "{},{},{},{lon},{lat},{}", p.x, p.y, p.z, pdf(p))?;
             }
         }
+        SphereFormat::GeoJson => {
+            write!(out, "{{\"type\":\"FeatureCollection\",\"features\":[")?;
+            for (k, p) in points.enumerate() {
+                let (lon, lat) = crate::healpix::lonlat_deg(p);
+                let sep = if k == 0 { "" } else { "," };
+                write!(
+                    out,
+                    "{sep}\n{{\"type\":\"Feature\",\"geometry\":{{\"type\":\"Point\",\"coordinates\":[{lon},{lat}]}},\"properties\":{{\"pdf\":{}}}}}",
+                    json_number(pdf(p))
+                )?;
+            }
+            writeln!(out, "\n]}}")?;
+        }
         SphereFormat::Bin => {
             write_utk_header(out, points.len(), 3)?;
             let mut buffer = Vec::with_capacity(24 << 12);
@@ -125,8 +143,60 @@ where
     Ok(())
 }
 
+/// A number as JSON has it: non-finite values become `null`.
+fn json_number(v: f64) -> String {
+    if v.is_finite() {
+        v.to_string()
+    } else {
+        "null".into()
+    }
+}
+
+/// Unit vectors of the Point and MultiPoint coordinates of a GeoJSON text
+/// (a FeatureCollection, a Feature or a bare geometry).
+fn read_geojson(bytes: &[u8]) -> Result<Vec<Vec<f64>>, String> {
+    let value: serde_json::Value =
+        serde_json::from_slice(bytes).map_err(|e| format!("not valid JSON: {e}"))?;
+    let mut out = Vec::new();
+    let mut stack = vec![&value];
+    while let Some(v) = stack.pop() {
+        match v.get("type").and_then(|t| t.as_str()) {
+            Some("FeatureCollection") => {
+                let features = v.get("features").and_then(|f| f.as_array());
+                stack.extend(features.into_iter().flatten().rev());
+            }
+            Some("Feature") => stack.extend(v.get("geometry")),
+            Some("Point") => out.push(v.get("coordinates")),
+            Some("MultiPoint") => {
+                let c = v.get("coordinates").and_then(|c| c.as_array());
+                out.extend(c.into_iter().flatten().map(Some));
+            }
+            other => {
+                return Err(format!(
+                    "unsupported GeoJSON object {other:?}; expected Points"
+                ))
+            }
+        }
+    }
+    out.into_iter()
+        .map(|c| {
+            let pair = c
+                .and_then(|c| c.as_array())
+                .map(|a| a.iter().map(|x| x.as_f64()).collect::<Option<Vec<f64>>>());
+            match pair {
+                Some(Some(v)) if v.len() >= 2 && v[1].abs() <= 90.0 && v[0].is_finite() => {
+                    let p = crate::density::sphere::lonlat_to_vec(v[0], v[1]);
+                    Ok(vec![p.x, p.y, p.z])
+                }
+                _ => Err("a Point's coordinates are not [lon, lat] in degrees".to_string()),
+            }
+        })
+        .collect()
+}
+
 /// Reads a point set written by tessera: UTK binary (detected by its magic)
-/// or text with `dims` numbers per line (blank lines and `#` comments
+/// GeoJSON Points (detected by a leading `{`; sphere points only), or text
+/// with `dims` numbers per line (blank lines and `#` comments
 /// skipped; a CSV header line is skipped and commas separate values).
 ///
 /// # Example
@@ -175,6 +245,12 @@ pub fn read_points_from(
                     .collect()
             })
             .collect());
+    }
+    if bytes.trim_ascii_start().starts_with(b"{") {
+        if dims != 3 {
+            return Err(fail("GeoJSON holds sphere points, not plane points".into()));
+        }
+        return read_geojson(&bytes).map_err(fail);
     }
     let mut points = Vec::new();
     for (number, line) in bytes.lines().enumerate() {

@@ -3,6 +3,8 @@
 //! * [`sphere`]: separation, spherical-cap L2 discrepancy (Stolarsky), Riesz
 //!   s = 1 energy, exact covering radius, mesh ratio and the angular power
 //!   spectrum of points on S².
+//! * [`irradiance`]: irradiance from an environment map, exact (per-pixel
+//!   quadrature) and Monte Carlo, and the relative RMSE between them.
 //! * [`plane`]: nearest-neighbour distances, Warnock's L2-star and
 //!   Hickernell's centred L2 discrepancy, periodogram with radial average and
 //!   anisotropy, and the low-frequency power of points in `[0, 1)²`.
@@ -18,6 +20,7 @@
 //! assert!(report.separation > 2.9 && report.separation < 3.3);
 //! ```
 
+pub mod irradiance;
 pub mod plane;
 pub mod sphere;
 

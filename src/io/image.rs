@@ -1,0 +1,388 @@
+//! Raster readers: OpenEXR (exr crate: scanline or tiled, f16/f32/u32, any
+//! channel order, every compression the crate decodes), Radiance `.hdr` and
+//! PNG (image crate), reduced to one importance value per pixel.
+//!
+//! Importance is Rec.709 luminance `0.2126 R + 0.7152 G + 0.0722 B` by
+//! default (a lone `Y` channel is used as is), or one named channel.
+//! Real files are hostile: negative, NaN and infinite pixels are counted and
+//! set to 0 (or refused with [`ReadOptions::strict`]); a file with nothing
+//! positive is an error naming it. No input makes the reader panic.
+//!
+//! ```
+//! use tessera::io::image::{read_raster, ReadOptions};
+//! let err = read_raster("no/such/map.exr".as_ref(), &ReadOptions::default()).unwrap_err();
+//! assert!(err.to_string().contains("no/such/map.exr"));
+//! ```
+
+use crate::Error;
+use std::path::Path;
+
+/// Largest raster read (pixels): refuses headers that would allocate
+/// gigabytes before any pixel is decoded.
+///
+/// # Example
+/// ```
+/// assert!(tessera::io::image::MAX_PIXELS >= 16384 * 8192);
+/// ```
+pub const MAX_PIXELS: usize = 1 << 28;
+
+/// How to turn a file into importance values.
+///
+/// # Example
+/// ```
+/// let o = tessera::io::image::ReadOptions { channel: Some("R".into()), ..Default::default() };
+/// assert!(!o.strict && o.decode_srgb);
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Use this channel (e.g. `R`, `Y`, `diffuse.G`) instead of luminance.
+    pub channel: Option<String>,
+    /// Refuse negative, NaN and infinite pixels instead of zeroing them.
+    pub strict: bool,
+    /// Undo the sRGB transfer curve of 8- and 16-bit PNGs (they store
+    /// display values; importance should be linear). EXR and `.hdr` are
+    /// linear already and are never changed.
+    pub decode_srgb: bool,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            channel: None,
+            strict: false,
+            decode_srgb: true,
+        }
+    }
+}
+
+/// One importance value per pixel, row 0 being the file's first (top) row.
+///
+/// # Example
+/// ```
+/// let r = tessera::io::image::Raster { width: 2, height: 1, values: vec![1.0, 0.0], bad_pixels: 0 };
+/// assert_eq!(r.get(1, 0), 0.0);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Raster {
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Row-major values, all finite and >= 0.
+    pub values: Vec<f64>,
+    /// Pixels that were negative, NaN or infinite and were set to 0.
+    pub bad_pixels: usize,
+}
+
+impl Raster {
+    /// The value at column `i`, row `j`.
+    ///
+    /// # Example
+    /// ```
+    /// let r = tessera::io::image::Raster { width: 1, height: 2, values: vec![3.0, 4.0], bad_pixels: 0 };
+    /// assert_eq!(r.get(0, 1), 4.0);
+    /// ```
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        self.values[j * self.width + i]
+    }
+
+    /// Builds a raster from raw importance values (row-major, `width *
+    /// height` of them), zeroing and counting bad ones; `strict` refuses
+    /// them, and a raster with nothing positive is refused. `name` is what
+    /// errors call the data.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::io::image::Raster;
+    /// let r = Raster::from_values("mem", 2, 1, vec![f64::NAN, 2.0], false).unwrap();
+    /// assert_eq!((r.values.clone(), r.bad_pixels), (vec![0.0, 2.0], 1));
+    /// assert!(Raster::from_values("mem", 2, 1, vec![f64::NAN, 2.0], true).is_err());
+    /// assert!(Raster::from_values("mem", 1, 1, vec![0.0], false).is_err());
+    /// ```
+    pub fn from_values(
+        name: impl AsRef<Path>,
+        width: usize,
+        height: usize,
+        values: Vec<f64>,
+        strict: bool,
+    ) -> Result<Raster, Error> {
+        let fail = |reason: String| Error::File {
+            path: name.as_ref().into(),
+            reason,
+        };
+        if width == 0 || height == 0 {
+            return Err(fail(format!("the image is empty ({width}x{height})")));
+        }
+        if width.checked_mul(height) != Some(values.len()) {
+            return Err(fail(format!(
+                "{} values for a {width}x{height} image",
+                values.len()
+            )));
+        }
+        let mut values = values;
+        let mut bad_pixels = 0;
+        let mut first_bad = None;
+        let mut any_positive = false;
+        for (k, v) in values.iter_mut().enumerate() {
+            if !(v.is_finite() && *v >= 0.0) {
+                bad_pixels += 1;
+                first_bad.get_or_insert((k % width, k / width, *v));
+                *v = 0.0;
+            }
+            any_positive |= *v > 0.0;
+        }
+        if let (true, Some((i, j, v))) = (strict, first_bad) {
+            return Err(fail(format!(
+                "{bad_pixels} pixel(s) are negative, NaN or infinite (first: column {i}, row {j}, value {v})"
+            )));
+        }
+        if !any_positive {
+            return Err(fail(
+                "every pixel is zero, negative or invalid: there is nothing to sample".into(),
+            ));
+        }
+        Ok(Raster {
+            width,
+            height,
+            values,
+            bad_pixels,
+        })
+    }
+}
+
+/// A named channel of decoded samples.
+struct Channel {
+    name: String,
+    samples: Vec<f32>,
+}
+
+/// Reads an EXR, Radiance `.hdr` or PNG file (recognised by its first
+/// bytes, not its name) into importance values.
+///
+/// # Example
+/// ```
+/// use tessera::io::image::{read_raster, ReadOptions};
+/// let dir = std::env::temp_dir().join("tessera-doc-read-raster");
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let path = dir.join("two.exr");
+/// exr::prelude::write_rgb_file(&path, 2, 1, |x, _| (x as f32, 1.0f32, 0.0f32)).unwrap();
+/// let r = read_raster(&path, &ReadOptions::default()).unwrap();
+/// assert!((r.get(1, 0) - (0.2126 + 0.7152)).abs() < 1e-6);
+/// ```
+pub fn read_raster(path: &Path, options: &ReadOptions) -> Result<Raster, Error> {
+    let fail = |reason: String| Error::File {
+        path: path.into(),
+        reason,
+    };
+    let mut magic = [0u8; 8];
+    let head = {
+        use std::io::Read;
+        let mut file = std::fs::File::open(path).map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?;
+        let mut n = 0;
+        while n < magic.len() {
+            match file.read(&mut magic[n..]) {
+                Ok(0) => break,
+                Ok(k) => n += k,
+                Err(source) => {
+                    return Err(Error::Io {
+                        path: path.into(),
+                        source,
+                    })
+                }
+            }
+        }
+        &magic[..n]
+    };
+    // the decoders are third-party code fed hostile bytes: a panic in one
+    // becomes an error naming the file
+    let guarded = |decode: &dyn Fn() -> Result<(usize, usize, Vec<Channel>, bool), String>| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
+            .unwrap_or_else(|_| Err("the decoder failed on this file".into()))
+            .map_err(fail)
+    };
+    let (width, height, channels, srgb) = if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        guarded(&|| read_exr(path).map(|(w, h, c)| (w, h, c, false)))?
+    } else if head.starts_with(b"#?") || head.starts_with(b"\x89PNG") {
+        guarded(&|| read_with_image_crate(path))?
+    } else if head.is_empty() {
+        return Err(fail("the file is empty".into()));
+    } else {
+        return Err(fail(
+            "not an OpenEXR, Radiance .hdr or PNG file (unrecognised first bytes)".into(),
+        ));
+    };
+    let decode = |v: f32| {
+        let v = v as f64;
+        if srgb && options.decode_srgb {
+            srgb_to_linear(v)
+        } else {
+            v
+        }
+    };
+    let names = || {
+        channels
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let values: Vec<f64> = match &options.channel {
+        Some(wanted) => {
+            let channel = find(&channels, wanted).ok_or_else(|| {
+                fail(format!(
+                    "no channel named '{wanted}'; the file has: {}",
+                    names()
+                ))
+            })?;
+            channel.samples.iter().map(|&v| decode(v)).collect()
+        }
+        None => match (
+            find(&channels, "R"),
+            find(&channels, "G"),
+            find(&channels, "B"),
+            find(&channels, "Y"),
+        ) {
+            (Some(r), Some(g), Some(b), _) => r
+                .samples
+                .iter()
+                .zip(&g.samples)
+                .zip(&b.samples)
+                .map(|((&r, &g), &b)| {
+                    let (r, g, b) = (decode(r), decode(g), decode(b));
+                    if r.is_finite() && g.is_finite() && b.is_finite() {
+                        0.2126 * r + 0.7152 * g + 0.0722 * b
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect(),
+            (_, _, _, Some(y)) => y.samples.iter().map(|&v| decode(v)).collect(),
+            _ => {
+                return Err(fail(format!(
+                    "no R, G, B or Y channels for luminance (the file has: {}); pick one with --channel",
+                    names()
+                )))
+            }
+        },
+    };
+    Raster::from_values(path, width, height, values, options.strict)
+}
+
+/// A channel by exact name, else by its last `.`-separated part, ignoring case.
+fn find<'a>(channels: &'a [Channel], wanted: &str) -> Option<&'a Channel> {
+    channels.iter().find(|c| c.name == wanted).or_else(|| {
+        channels.iter().find(|c| {
+            let short = c.name.rsplit('.').next().unwrap_or(&c.name);
+            short.eq_ignore_ascii_case(wanted)
+        })
+    })
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1).
+fn srgb_to_linear(v: f64) -> f64 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Channel>), String> {
+    use exr::prelude::*;
+    // the header first: refuse absurd sizes before allocating for them
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+    let header = meta
+        .headers
+        .iter()
+        .find(|h| !h.deep)
+        .ok_or("the file holds only deep data, which has no per-pixel value")?;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    check_size(w, h)?;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| e.to_string())?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    check_size(w, h)?;
+    let mut channels = Vec::new();
+    for c in layer.channel_data.list {
+        let name = c.name.to_string();
+        if c.sample_data.len() != w * h {
+            return Err(format!(
+                "channel '{name}' is subsampled ({} samples for {w}x{h} pixels), which is not supported",
+                c.sample_data.len()
+            ));
+        }
+        let samples = c.sample_data.values_as_f32().collect();
+        channels.push(Channel { name, samples });
+    }
+    Ok((w, h, channels))
+}
+
+fn check_size(w: usize, h: usize) -> Result<(), String> {
+    if w == 0 || h == 0 {
+        return Err(format!("the image is empty ({w}x{h})"));
+    }
+    match w.checked_mul(h) {
+        Some(n) if n <= MAX_PIXELS => Ok(()),
+        _ => Err(format!(
+            "{w}x{h} pixels is more than the {MAX_PIXELS} this reader accepts"
+        )),
+    }
+}
+
+fn read_with_image_crate(path: &Path) -> Result<(usize, usize, Vec<Channel>, bool), String> {
+    let reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| e.to_string())?;
+    let image = reader.decode().map_err(|e| e.to_string())?;
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    check_size(w, h)?;
+    let color = image.color();
+    // integer formats hold display (sRGB) values; float formats are linear
+    let srgb = !matches!(color, image::ColorType::Rgb32F | image::ColorType::Rgba32F);
+    let rgba = image.into_rgba32f().into_raw();
+    let plane = |k: usize| {
+        rgba.iter()
+            .skip(k)
+            .step_by(4)
+            .copied()
+            .collect::<Vec<f32>>()
+    };
+    let mut channels = if color.has_color() {
+        vec![
+            Channel {
+                name: "R".into(),
+                samples: plane(0),
+            },
+            Channel {
+                name: "G".into(),
+                samples: plane(1),
+            },
+            Channel {
+                name: "B".into(),
+                samples: plane(2),
+            },
+        ]
+    } else {
+        vec![Channel {
+            name: "Y".into(),
+            samples: plane(0),
+        }]
+    };
+    if color.has_alpha() {
+        channels.push(Channel {
+            name: "A".into(),
+            samples: plane(3),
+        });
+    }
+    Ok((w, h, channels, srgb))
+}

@@ -1,0 +1,111 @@
+//! Irradiance `E(n) = integral of L(w) max(0, n . w) dw` from an environment
+//! map: the reference value by quadrature over the map's own pixels, the
+//! Monte Carlo estimate `(1/N) sum L(w_i) max(0, n . w_i) / pdf(w_i)` from
+//! samples, and the relative RMSE over several normals.
+//!
+//! ```
+//! use tessera::density::envmap::{EnvMap, Up};
+//! use tessera::io::image::Raster;
+//! use tessera::metrics::irradiance::{estimate, exact};
+//! let map = EnvMap::new(Raster { width: 8, height: 4, values: vec![1.0; 32], bad_pixels: 0 }, Up::Z).unwrap();
+//! // a constant unit sky gives pi on every normal
+//! let e = exact(&map, &[glam::DVec3::Z]);
+//! assert!((e[0] - std::f64::consts::PI).abs() < 1e-3);
+//! let s: Vec<_> = map.generate(4096).unwrap().iter().map(|s| s.position).collect();
+//! assert!((estimate(&map, &s, glam::DVec3::Z) / e[0] - 1.0).abs() < 0.01);
+//! ```
+
+use crate::density::envmap::EnvMap;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Reference irradiance for each normal: a midpoint rule on 4x4 sub-pixels
+/// (uniform in solid angle) of every lit pixel, 32x32 for pixels holding
+/// more than 1e-4 of the map's integral (a sun).
+///
+/// # Example
+/// ```
+/// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, metrics::irradiance::exact};
+/// let map = EnvMap::new(Raster { width: 8, height: 4, values: vec![2.0; 32], bad_pixels: 0 }, Up::Z).unwrap();
+/// assert!((exact(&map, &[glam::DVec3::X])[0] - 2.0 * std::f64::consts::PI).abs() < 1e-3);
+/// ```
+pub fn exact(map: &EnvMap, normals: &[DVec3]) -> Vec<f64> {
+    let (w, h) = (map.width(), map.height());
+    // row by row: each row's sub-pixel nodes against every normal
+    (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut sums = vec![0.0; normals.len()];
+            for i in 0..w {
+                let v = map.values()[j * w + i];
+                if v <= 0.0 {
+                    continue;
+                }
+                let mass = v * map.pixel_solid_angle(j);
+                let k = if mass > 1e-4 * map.integral() { 32 } else { 4 };
+                let weight = mass / (k * k) as f64;
+                for s in 0..k * k {
+                    let (u, t) = (
+                        ((s % k) as f64 + 0.5) / k as f64,
+                        ((s / k) as f64 + 0.5) / k as f64,
+                    );
+                    let d = map.direction_in_pixel(i, j, u, t);
+                    for (sum, n) in sums.iter_mut().zip(normals) {
+                        *sum += weight * n.dot(d).max(0.0);
+                    }
+                }
+            }
+            sums
+        })
+        .reduce(
+            || vec![0.0; normals.len()],
+            |mut a, b| {
+                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+                a
+            },
+        )
+}
+
+/// The Monte Carlo estimate of `E(normal)` from samples of the map's pdf
+/// ([`EnvMap::pdf`]); samples where the pdf is 0 contribute nothing.
+///
+/// # Example
+/// ```
+/// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, metrics::irradiance::estimate};
+/// let map = EnvMap::new(Raster { width: 2, height: 1, values: vec![1.0, 1.0], bad_pixels: 0 }, Up::Z).unwrap();
+/// // all the mass of one direction along the normal: 4 pi radiance-weighted
+/// assert!((estimate(&map, &[glam::DVec3::Z], glam::DVec3::Z) - 4.0 * std::f64::consts::PI).abs() < 1e-9);
+/// ```
+pub fn estimate(map: &EnvMap, samples: &[DVec3], normal: DVec3) -> f64 {
+    let sum: f64 = samples
+        .iter()
+        .map(|&d| {
+            let pdf = map.pdf(d);
+            if pdf > 0.0 {
+                map.radiance(d) * normal.dot(d).max(0.0) / pdf
+            } else {
+                0.0
+            }
+        })
+        .sum();
+    sum / samples.len().max(1) as f64
+}
+
+/// Relative RMSE of estimates against references:
+/// `sqrt(mean(((e - r) / r)^2))`, over the pairs with `r > 0`.
+///
+/// # Example
+/// ```
+/// use tessera::metrics::irradiance::relative_rmse;
+/// assert!((relative_rmse(&[1.1, 0.9], &[1.0, 1.0]) - 0.1).abs() < 1e-12);
+/// ```
+pub fn relative_rmse(estimates: &[f64], references: &[f64]) -> f64 {
+    let (sum, count) = estimates
+        .iter()
+        .zip(references)
+        .filter(|(_, &r)| r > 0.0)
+        .fold((0.0, 0usize), |(s, c), (e, r)| {
+            (s + ((e - r) / r).powi(2), c + 1)
+        });
+    (sum / count.max(1) as f64).sqrt()
+}
