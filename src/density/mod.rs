@@ -5,6 +5,7 @@
 //! be skipped) and an average (to threshold the tile's code). Values are
 //! relative: only ratios matter, and the engine scales by the requested count.
 
+pub mod plane;
 pub mod sphere;
 
 /// The geometry a density sees of a tile.
