@@ -285,7 +285,9 @@ pub struct PlaneLut {
     /// The automaton, row-major: `transitions[class * A + child]`.
     pub transitions: Vec<u32>,
     /// Importance bins per class; bin `b` was optimised for the density
-    /// fraction `1/A + (1 - 1/A) b / (bins - 1)` of a level's capacity.
+    /// fraction `A^(b / (bins - 1) - 1)` of a level's capacity (equal
+    /// ratios between bins: a fraction served by the bin above it misses
+    /// at most the same share of points everywhere).
     pub bins: u16,
     /// Offsets in the tile's frame (cells times [`PLANE_OFFSET_SCALE`]),
     /// indexed `class * bins + bin`.
@@ -326,8 +328,7 @@ impl PlaneLut {
     /// ```
     pub fn bin_fraction(&self, bin: usize) -> f64 {
         let a = self.arity() as f64;
-        let step = (1.0 - 1.0 / a) / (self.bins.max(2) - 1) as f64;
-        1.0 / a + step * bin as f64
+        a.powf(bin as f64 / (self.bins.max(2) - 1) as f64 - 1.0)
     }
 
     /// The offset (tile frame, cells) of class `class` in bin `bin`.

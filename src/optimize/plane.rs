@@ -17,7 +17,9 @@
 //!    the ancestor's border); the report gives how often tiles of one state
 //!    share one neighbourhood;
 //! 5. offsets per (structural index, importance bin): Lloyd relaxation of the
-//!    tiles a bin's density fraction accepts, every state sharing one offset.
+//!    tiles a bin's density fraction accepts, every state sharing one offset;
+//!    then a few separation steps push apart the rare close pairs that shared
+//!    offsets leave where a state meets an unusual neighbourhood.
 
 use crate::baselines::SplitMix64;
 use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
@@ -57,6 +59,8 @@ pub struct BuildOptions {
     pub quadrature: usize,
     /// Over-relaxation factor of the Lloyd steps (1 = plain Lloyd).
     pub relaxation: f64,
+    /// Separation steps after Lloyd (see the module notes).
+    pub separation_steps: usize,
 }
 
 impl BuildOptions {
@@ -69,7 +73,6 @@ impl BuildOptions {
     /// ```
     pub fn for_system(system: PlaneSystem) -> Self {
         match system {
-            // one bin per digit count: each bin is exactly a set the codes keep
             PlaneSystem::Ghexomino => BuildOptions {
                 seed: 1,
                 iterations: 24,
@@ -78,15 +81,17 @@ impl BuildOptions {
                 lloyd_level: 1,
                 quadrature: 2,
                 relaxation: 1.5,
+                separation_steps: 24,
             },
             PlaneSystem::Ppentomino => BuildOptions {
                 seed: 1,
                 iterations: 24,
-                bins: 13,
+                bins: 25,
                 depth: 3,
                 lloyd_level: 4,
                 quadrature: 3,
                 relaxation: 1.5,
+                separation_steps: 24,
             },
         }
     }
@@ -227,15 +232,13 @@ fn root_patch(
             Ok((10, found.into_iter().next().ok_or_else(none)?))
         }
         PlaneSystem::Ghexomino => {
-            // 12x9 rectangles of 18 tiles, 3 across and 4 down
-            let covers = tilings(shape, &rect(12, 9), 16, rng.next_u64() | 1);
-            if covers.is_empty() {
-                return Err(none());
-            }
+            // 12x9 rectangles of 18 tiles, 3 across and 4 down, each its
+            // own randomly ordered search, so borders differ
             let mut roots = Vec::new();
             for j in 0..4 {
                 for i in 0..3 {
-                    let cover = &covers[(rng.next_u64() % covers.len() as u64) as usize];
+                    let covers = tilings(shape, &rect(12, 9), 1, rng.next_u64() | 1);
+                    let cover = covers.first().ok_or_else(none)?;
                     roots.extend(cover.iter().map(|p| {
                         Placement::new((p.origin.0 + 12 * i, p.origin.1 + 9 * j), p.orientation)
                     }));
@@ -524,13 +527,7 @@ fn relax(
     let mut offsets: Vec<[f64; 2]> = (0..lut.classes()).map(|c| lut.offset(c, bin)).collect();
     let mut residual = 0.0;
     for _ in 0..options.iterations {
-        let sites: Vec<[f64; 2]> = tiles
-            .iter()
-            .map(|t| {
-                let [x, y] = t.placement.to_lattice(offsets[t.class as usize]);
-                [x.rem_euclid(p), y.rem_euclid(p)]
-            })
-            .collect();
+        let sites = sites_of(&tiles, &offsets, p);
         let grid = TorusGrid::new(&sites, p);
         // nearest site of every quadrature point, rows in parallel; sums in
         // row order so the result does not depend on the thread count
@@ -581,12 +578,82 @@ fn relax(
             }
         }
     }
+    separate(&tiles, &mut offsets, p, options.separation_steps);
     for (c, o) in offsets.iter().enumerate() {
         if depths[c] == depth {
             lut.offsets[c * bins + bin] = PlaneLut::quantise(*o);
         }
     }
     residual
+}
+
+/// Sites of the tiles on the torus of period `p`.
+fn sites_of(tiles: &[PlaneTile], offsets: &[[f64; 2]], p: f64) -> Vec<[f64; 2]> {
+    tiles
+        .iter()
+        .map(|t| {
+            let [x, y] = t.placement.to_lattice(offsets[t.class as usize]);
+            [x.rem_euclid(p), y.rem_euclid(p)]
+        })
+        .collect()
+}
+
+/// After Lloyd: shared offsets leave a few close pairs where one class
+/// meets an unusual neighbourhood. Each step pushes the sites closer than
+/// 0.8 hexagonal spacings apart, moves every class by the mean push of its
+/// pushed instances (in tile frames), and the offsets with the largest
+/// minimum distance seen are kept.
+fn separate(tiles: &[PlaneTile], offsets: &mut [[f64; 2]], p: f64, steps: usize) {
+    let spacing = (2.0 * p * p / (3f64.sqrt() * tiles.len() as f64)).sqrt();
+    let target = 0.8 * spacing;
+    let min_distance = |offsets: &[[f64; 2]]| {
+        let sites = sites_of(tiles, offsets, p);
+        let grid = TorusGrid::new(&sites, p);
+        (0..sites.len())
+            .map(|k| grid.nearest(sites[k], Some(k)))
+            .map(|(j, d2)| (j, d2.sqrt()))
+            .collect::<Vec<_>>()
+    };
+    let mut best = offsets.to_vec();
+    let mut best_min = f64::NEG_INFINITY;
+    for _ in 0..=steps {
+        let sites = sites_of(tiles, offsets, p);
+        let nearest = min_distance(offsets);
+        let min = nearest.iter().map(|n| n.1).fold(f64::INFINITY, f64::min);
+        if min > best_min {
+            best_min = min;
+            best.copy_from_slice(offsets);
+        }
+        let mut push = vec![[0.0f64; 2]; offsets.len()];
+        let mut pushed = vec![0usize; offsets.len()];
+        for (k, t) in tiles.iter().enumerate() {
+            let (j, d) = nearest[k];
+            if d >= target || d == 0.0 {
+                continue;
+            }
+            let v = [
+                wrap_half(sites[k][0] - sites[j][0], p) / d,
+                wrap_half(sites[k][1] - sites[j][1], p) / d,
+            ];
+            let step = 0.5 * (target - d);
+            let local = t
+                .placement
+                .orientation
+                .inverse()
+                .apply_f64([v[0] * step, v[1] * step]);
+            let c = t.class as usize;
+            push[c][0] += local[0];
+            push[c][1] += local[1];
+            pushed[c] += 1;
+        }
+        for c in 0..offsets.len() {
+            if pushed[c] > 0 {
+                offsets[c][0] += push[c][0] / pushed[c] as f64;
+                offsets[c][1] += push[c][1] / pushed[c] as f64;
+            }
+        }
+    }
+    offsets.copy_from_slice(&best);
 }
 
 /// `v` reduced into `[-p/2, p/2)`.

@@ -112,6 +112,8 @@ pub struct PlaneTiling {
     child_of_digit: Vec<u8>,
     /// Decoded offsets, `class * bins + bin`.
     offsets: Vec<[f64; 2]>,
+    /// The density fraction each bin was optimised for, increasing.
+    bin_fractions: Vec<f64>,
     /// Roots times `A^level`: the weight of a level's new digit.
     digit_weight: Vec<u64>,
     /// `1 / (side * scale^level)`: lattice to unit square.
@@ -159,6 +161,9 @@ impl PlaneTiling {
         let offsets = (0..lut.classes() * lut.bins as usize)
             .map(|k| lut.offset(k / lut.bins as usize, k % lut.bins as usize))
             .collect();
+        let bin_fractions = (0..lut.bins as usize)
+            .map(|b| lut.bin_fraction(b))
+            .collect();
         let mut roots_by_code: Vec<PlaneTile> = (0..lut.roots.len())
             .map(|r| PlaneTile {
                 placement: lut.roots[r],
@@ -180,6 +185,7 @@ impl PlaneTiling {
             child_digit,
             child_of_digit,
             offsets,
+            bin_fractions,
             digit_weight,
             inv_size,
             lut,
@@ -319,17 +325,11 @@ impl PlaneTiling {
     /// ```
     #[inline]
     pub fn bin(&self, fraction: f64) -> usize {
-        let a = self.arity as f64;
-        let steps = (fraction - 1.0 / a) / (1.0 - 1.0 / a) * (self.bins - 1) as f64;
         // a relative tolerance keeps exact bin fractions in their own bin
-        let b = (steps - 1e-9).ceil();
-        if b >= (self.bins - 1) as f64 {
-            self.bins - 1
-        } else if b > 0.0 {
-            b as usize
-        } else {
-            0
-        }
+        let b = self
+            .bin_fractions
+            .partition_point(|&edge| edge * (1.0 + 1e-9) < fraction);
+        b.min(self.bins - 1)
     }
 
     #[inline]
