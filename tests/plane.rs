@@ -245,10 +245,16 @@ fn streaming_matches_generation() {
 fn the_deepest_level_keeps_codes_and_points_apart() {
     for (_, tiling) in systems() {
         let level = tiling.max_level();
-        let cap = tiling.capacity(level);
-        assert!(cap < u64::MAX as f64);
+        let lut = tiling.lut();
+        // exact: the f64 capacity rounds at these sizes
+        let cap = lut.roots.len() as u128 * (lut.arity() as u128).pow(level);
+        assert!(cap <= u64::MAX as u128);
+        // and the level is the deepest: one more overflows codes or lattice
+        let side = lut.side as i128 * (lut.rules[0].scale as i128).pow(level + 1);
+        assert!(cap * lut.arity() as u128 > u64::MAX as u128 || side > i32::MAX as i128 / 2);
+        let cap = cap as u64;
         let mut seen = Vec::new();
-        for code in [0u64, 1, 2, cap as u64 / 2, cap as u64 - 1] {
+        for code in [0u64, 1, 2, cap / 2, cap - 1] {
             let tile = tiling.tile_with_code(level, code).unwrap();
             assert_eq!(tile.code, code);
             let p = tiling.sample(&tile, 1.0);
@@ -260,6 +266,7 @@ fn the_deepest_level_keeps_codes_and_points_apart() {
                 assert_ne!(seen[i], seen[j]);
             }
         }
+        assert!(tiling.tile_with_code(level, cap).is_none());
         assert!(tiling.tile_with_code(level + 1, 0).is_none());
     }
 }

@@ -14,8 +14,8 @@
 //! 4. structural indices: the automaton whose state is the rule of the
 //!    ancestor `depth` levels up and the child numbers since (the tile's
 //!    position inside that ancestor, which fixes its neighbourhood except at
-//!    the ancestor's border); the report gives how often tiles of one state
-//!    share one neighbourhood;
+//!    the ancestor's border); shallower tiles have their own states; the
+//!    report gives how often tiles of one state share one neighbourhood;
 //! 5. offsets per (structural index, importance bin): Lloyd relaxation of the
 //!    tiles a bin's density fraction accepts, every state sharing one offset;
 //!    then a few separation steps push apart the rare close pairs that shared
@@ -51,11 +51,17 @@ pub struct BuildOptions {
     pub iterations: usize,
     /// Importance bins, linear in the density fraction from `1/A` to 1.
     pub bins: u16,
-    /// Levels of history in a structural index.
+    /// Structural indices tell tiles apart by their depth below the roots
+    /// up to this depth (a child of a root sits in a different
+    /// neighbourhood than a child of an inner tile).
     pub depth: u32,
-    /// Level on which the deep structural indices are relaxed.
+    /// Level on which the deepest structural indices are relaxed.
     pub lloyd_level: u32,
-    /// Quadrature points per cell side in Lloyd relaxation.
+    /// Largest number of sites relaxed at once; a bin with more sites at
+    /// `lloyd_level` is relaxed on the deepest level that fits (at least
+    /// `depth`).
+    pub max_sites: usize,
+    /// Quadrature points per site in Lloyd relaxation.
     pub quadrature: usize,
     /// Over-relaxation factor of the Lloyd steps (1 = plain Lloyd).
     pub relaxation: f64,
@@ -79,7 +85,8 @@ impl BuildOptions {
                 bins: 81,
                 depth: 1,
                 lloyd_level: 1,
-                quadrature: 2,
+                max_sites: 80_000,
+                quadrature: 24,
                 relaxation: 1.5,
                 separation_steps: 24,
             },
@@ -89,7 +96,8 @@ impl BuildOptions {
                 bins: 25,
                 depth: 3,
                 lloyd_level: 4,
-                quadrature: 3,
+                max_sites: 80_000,
+                quadrature: 40,
                 relaxation: 1.5,
                 separation_steps: 24,
             },
@@ -155,7 +163,7 @@ pub fn build(
     let arity = rules[0].children.len();
     if options.bins < 2 || options.depth == 0 || options.lloyd_level < options.depth {
         return Err(Error::Request(
-            "need at least 2 bins, depth >= 1 and lloyd_level >= depth".into(),
+            "need at least 2 bins and 1 <= depth <= lloyd_level".into(),
         ));
     }
     let mut rng = SplitMix64::new(options.seed);
@@ -186,21 +194,26 @@ pub fn build(
     lut.bins = options.bins;
     let centroid = PlaneLut::quantise(shape.centroid());
     lut.offsets = vec![centroid; lut.classes() * options.bins as usize];
-    let agreement = neighbourhood_agreement(&lut, options.lloyd_level);
+    let tiling = PlaneTiling::new(Arc::new(lut.clone()));
+    let agreement_level = (0..=options.lloyd_level)
+        .rev()
+        .find(|&l| tiling.capacity(l) <= 200_000.0)
+        .unwrap_or(0);
+    let agreement = neighbourhood_agreement(&lut, agreement_level);
     let started = Instant::now();
     let mut residuals = Vec::new();
+    let deepest = options.depth;
     for bin in 0..options.bins as usize {
         progress("lloyd", bin as u64, options.bins as u64);
-        let mut residual = 0.0;
-        for depth in 0..=options.depth {
-            let level = if depth < options.depth {
-                depth
-            } else {
-                options.lloyd_level
-            };
-            residual = relax(&mut lut, &depths, depth, level, bin, options);
+        for depth in 0..deepest {
+            relax(&mut lut, &depths, depth, depth, bin, options);
         }
-        residuals.push(residual);
+        let sites = |l: u32| lut.bin_fraction(bin) * tiling.capacity(l);
+        let level = (deepest..=options.lloyd_level)
+            .rev()
+            .find(|&l| sites(l) <= options.max_sites as f64)
+            .unwrap_or(deepest);
+        residuals.push(relax(&mut lut, &depths, deepest, level, bin, options));
     }
     progress("lloyd", options.bins as u64, options.bins as u64);
     let report = BuildReport {
@@ -521,8 +534,9 @@ fn relax(
         return 0.0;
     }
     let p = period(lut, level);
-    let q = options.quadrature.max(1);
-    let n = p.round() as usize * q;
+    // a square grid of about `quadrature` points per site
+    let n = ((options.quadrature.max(1) * tiles.len()) as f64).sqrt().ceil() as usize;
+    let h = p / n as f64;
     let bins = lut.bins as usize;
     let mut offsets: Vec<[f64; 2]> = (0..lut.classes()).map(|c| lut.offset(c, bin)).collect();
     let mut residual = 0.0;
@@ -536,7 +550,7 @@ fn relax(
             .map(|j| {
                 (0..n)
                     .map(|i| {
-                        let qp = [(i as f64 + 0.5) / q as f64, (j as f64 + 0.5) / q as f64];
+                        let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
                         grid.nearest(qp, None).0 as u32
                     })
                     .collect()
@@ -546,7 +560,7 @@ fn relax(
         let mut count = vec![0usize; sites.len()];
         for (j, row) in rows.iter().enumerate() {
             for (i, &s) in row.iter().enumerate() {
-                let qp = [(i as f64 + 0.5) / q as f64, (j as f64 + 0.5) / q as f64];
+                let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
                 let s = s as usize;
                 sum[s][0] += wrap_half(qp[0] - sites[s][0], p);
                 sum[s][1] += wrap_half(qp[1] - sites[s][1], p);

@@ -443,7 +443,7 @@ impl TileSystem for PlaneTiling {
     }
 
     fn tile_with_code(&self, level: u32, code: u64) -> Option<PlaneTile> {
-        if level > self.max_level || code as f64 >= self.capacity(level) {
+        if level > self.max_level || code >= self.digit_weight[level as usize] {
             return None;
         }
         let roots = self.roots_by_code.len() as u64;
