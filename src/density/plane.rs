@@ -180,7 +180,9 @@ impl Raster {
         let w = self.width + 1;
         let s = |r: usize, c: usize| self.sums[r * w + c];
         let total = s(r1 + 1, c1 + 1) - s(r0, c1 + 1) - s(r1 + 1, c0) + s(r0, c0);
-        total / ((c1 + 1 - c0) * (r1 + 1 - r0)) as f64
+        // the differences of large sums carry rounding of about 1e-16 times
+        // the image's total (values are normalised to a maximum of 1)
+        (total / ((c1 + 1 - c0) * (r1 + 1 - r0)) as f64).max(0.0)
     }
 }
 
@@ -203,7 +205,9 @@ impl Density<PlaneRegion> for Raster {
         best
     }
     fn average(&self, region: &PlaneRegion) -> f64 {
-        let h = 0.5 * region.cell;
+        // cells lie inside the bounding box; shrinking them by a hair keeps
+        // rounding from reaching a pixel the bound did not see
+        let h = 0.5 * region.cell * (1.0 - 1e-9);
         let c = region.centres();
         c.iter()
             .map(|p| {

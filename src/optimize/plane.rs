@@ -535,7 +535,9 @@ fn relax(
     }
     let p = period(lut, level);
     // a square grid of about `quadrature` points per site
-    let n = ((options.quadrature.max(1) * tiles.len()) as f64).sqrt().ceil() as usize;
+    let n = ((options.quadrature.max(1) * tiles.len()) as f64)
+        .sqrt()
+        .ceil() as usize;
     let h = p / n as f64;
     let bins = lut.bins as usize;
     let mut offsets: Vec<[f64; 2]> = (0..lut.classes()).map(|c| lut.offset(c, bin)).collect();

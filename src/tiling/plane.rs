@@ -344,15 +344,19 @@ impl PlaneTiling {
     }
 }
 
-/// `v` modulo 1, in `[0, 1)`.
+/// `v` mirrored into `[0, 1)` at the square's edges.
 #[inline]
 fn wrap(v: f64) -> f64 {
-    let w = v - v.floor();
-    if w < 1.0 {
-        w
+    let w = if v < 0.0 {
+        -v
+    } else if v >= 1.0 {
+        2.0 - v
     } else {
-        0.0
-    }
+        return v;
+    };
+    // offsets move points less than a root tile, so one mirror suffices;
+    // the largest f64 below 1 keeps the half-open square
+    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }
 
 impl TileSystem for PlaneTiling {
