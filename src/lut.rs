@@ -390,7 +390,7 @@ impl PlaneLut {
         let bad = |what: &str| Err(Error::Table(format!("planar table: {what}")));
         let a = self.arity();
         let cells = self.shape.cells().len();
-        if a < 2 || a > 256 || cells == 0 || cells > crate::tiling::plane::MAX_CELLS {
+        if !(2..=256).contains(&a) || !(1..=crate::tiling::plane::MAX_CELLS).contains(&cells) {
             return bad("the shape needs 1..=8 cells and 2..=256 children per rule");
         }
         let scale = self.rules[0].scale;

@@ -463,7 +463,9 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
             owner.insert((x as i64, y as i64), i);
         }
     }
-    let mut counts: HashMap<(u32, Vec<(i32, i32, usize)>), usize> = HashMap::new();
+    // (class, the neighbours' origins and orientations in the tile's frame)
+    type Neighbourhood = (u32, Vec<(i32, i32, usize)>);
+    let mut counts: HashMap<Neighbourhood, usize> = HashMap::new();
     for (i, t) in tiles.iter().enumerate() {
         let inverse = t.placement.orientation.inverse();
         let mut signature: Vec<(i32, i32, usize)> = Vec::new();
