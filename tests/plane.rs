@@ -8,7 +8,7 @@ use tessera::density::plane::{Ramp, Raster};
 use tessera::density::{Density, Uniform};
 use tessera::engine;
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
-use tessera::metrics::plane::{low_frequency_power, min_distance};
+use tessera::metrics::plane::{low_frequency_power, min_distance, periodogram, radial_average};
 use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
 use tessera::tiling::TileSystem;
 
@@ -37,8 +37,16 @@ fn uniform_4096_is_blue_noise() {
         let points = positions(&tiling, &Uniform, 4096);
         let d = min_distance(&points);
         let low = low_frequency_power(&points);
+        // the largest peak of the radially averaged spectrum up to |k| = 128
+        let size = 256;
+        let radial = radial_average(&periodogram(&points, size), size);
+        let (peak_at, peak) = radial
+            .iter()
+            .enumerate()
+            .skip(1)
+            .fold((0, 0.0f64), |b, (r, &v)| if v > b.1 { (r, v) } else { b });
         println!(
-            "{}: min distance {d:.3}, low-frequency power {low:.3}",
+            "{}: min distance {d:.3}, low-frequency power {low:.3}, radial peak {peak:.2} at |k| = {peak_at}",
             system.name()
         );
         assert!(d >= 0.55, "{}: normalised min distance {d}", system.name());
