@@ -72,13 +72,15 @@ pub struct Raster {
 
 impl Raster {
     /// A raster density from pixel values (non-negative, finite), row-major
-    /// with row 0 on top. `invert` uses `max - value` instead.
+    /// with row 0 on top. `invert` uses `max - value` instead. Values are
+    /// then normalised to a maximum of 1 (only ratios matter).
     ///
     /// # Example
     /// ```
     /// use tessera::density::plane::Raster;
-    /// let r = Raster::new(1, 2, vec![0.25, 1.0], true).unwrap();
-    /// assert_eq!(r.pixel(glam::DVec2::new(0.5, 0.1)), 0.75); // top row, inverted
+    /// let r = Raster::new(1, 3, vec![0.0, 0.5, 1.0], true).unwrap();
+    /// assert_eq!(r.pixel(glam::DVec2::new(0.5, 0.1)), 1.0); // top row, inverted
+    /// assert_eq!(r.pixel(glam::DVec2::new(0.5, 0.5)), 0.5);
     /// assert!(Raster::new(0, 2, vec![], false).is_err());
     /// ```
     pub fn new(width: usize, height: usize, values: Vec<f64>, invert: bool) -> Result<Self, Error> {
@@ -232,7 +234,7 @@ impl Density<PlaneRegion> for Raster {
 /// ```
 /// use tessera::density::plane::parse;
 /// assert!(parse("ramp").is_ok());
-/// assert!(parse("ramp:2").unwrap_err().to_string().contains("ramp:2"));
+/// assert!(parse("ramp:2").is_err_and(|e| e.to_string().contains("ramp:2")));
 /// ```
 pub fn parse(spec: &str) -> Result<Box<dyn Density<PlaneRegion> + Send>, Error> {
     match spec {
