@@ -373,3 +373,105 @@ proptest! {
         }
     }
 }
+
+fn tessera(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
+    for system in ["ghexomino", "ppentomino"] {
+        let out = tessera(&[
+            "plane",
+            "--system",
+            system,
+            "--density",
+            "ramp",
+            "-n",
+            "300",
+        ]);
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 300);
+        for line in text.lines() {
+            let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+            assert!(v.len() == 2 && in_domain(&DVec2::new(v[0], v[1])));
+        }
+        let bin = tessera(&["plane", "--system", system, "-n", "7", "--format", "bin"]).stdout;
+        assert_eq!(bin.len(), 20 + 7 * 16);
+        let rows = tessera::io::points::read_points_from(&bin[..], 2, "stdout").unwrap();
+        assert_eq!(rows.len(), 7);
+        let dir =
+            std::env::temp_dir().join(format!("tessera-plane-{system}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let svg = dir.join("tiles.svg");
+        let out = tessera(&[
+            "tiles",
+            "--system",
+            system,
+            "--level",
+            "1",
+            "--svg",
+            svg.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+        let drawing = std::fs::read_to_string(&svg).unwrap();
+        let tiles = plane_lut(if system == "ghexomino" {
+            PlaneSystem::Ghexomino
+        } else {
+            PlaneSystem::Ppentomino
+        })
+        .roots
+        .len()
+            * if system == "ghexomino" { 81 } else { 4 };
+        assert_eq!(drawing.matches("<polygon").count(), tiles);
+        assert_eq!(drawing.matches("<circle").count(), tiles);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    for (args, why) in [
+        (
+            &[
+                "plane",
+                "--system",
+                "ppentomino",
+                "--density",
+                "cap:1",
+                "-n",
+                "5",
+            ][..],
+            "cap:1",
+        ),
+        (
+            &[
+                "plane",
+                "--system",
+                "ppentomino",
+                "-n",
+                "5",
+                "--format",
+                "xyz",
+            ][..],
+            "xyz",
+        ),
+        (
+            &[
+                "tiles",
+                "--system",
+                "ghexomino",
+                "--level",
+                "3",
+                "--svg",
+                "/tmp/x.svg",
+            ][..],
+            "level 3",
+        ),
+    ] {
+        let out = tessera(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(why), "{args:?}: {err}");
+    }
+}
