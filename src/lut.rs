@@ -162,8 +162,14 @@ impl SphereLut {
         if self.child_rule.len() != 2 || self.child_digit.len() != 2 {
             return bad("child rule/digit tables must have two rows");
         }
-        if self.child_rule.iter().flatten().any(|&r| r > 1) {
-            return bad("child rule out of range");
+        if self
+            .child_rule
+            .iter()
+            .flatten()
+            .chain(&self.root_rule)
+            .any(|&r| r > 1)
+        {
+            return bad("child or root rule out of range");
         }
         for digits in &self.child_digit {
             let mut sorted = *digits;
@@ -290,6 +296,288 @@ pub fn sphere_lut() -> Arc<SphereLut> {
         Arc::new(
             SphereLut::from_bytes(SPHERE_BYTES)
                 .expect("the embedded luts/sphere.lut is checked by the test suite"),
+        )
+    })
+    .clone()
+}
+
+/// Format version written into and required from planar polyomino tables.
+pub const PLANE_LUT_VERSION: u32 = 1;
+
+/// Planar offsets are stored as `i16` multiples of `1 / PLANE_OFFSET_SCALE`
+/// cells (resolution 1e-3 cells, range +-32 cells: sparse importance bins of
+/// the 81-rep G-hexomino move points several cells).
+pub const PLANE_OFFSET_SCALE: f64 = 1024.0;
+
+/// Everything a planar polyomino tile system needs at run time: the rep-tile
+/// rules, the root patch covering the unit square, codes, the class
+/// automaton and the offsets.
+///
+/// # Example
+/// ```
+/// use tessera::lut::{plane_lut, PlaneSystem};
+/// let lut = plane_lut(PlaneSystem::Ppentomino);
+/// assert_eq!(lut.roots.len(), 20);
+/// assert_eq!(lut.rules[0].children.len(), 4);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlaneLut {
+    /// Format version, [`PLANE_LUT_VERSION`].
+    pub version: u32,
+    /// Seed the optimiser ran with.
+    pub seed: u64,
+    /// The rep-tile.
+    pub shape: crate::tiling::polyomino::Shape,
+    /// Its production rules (all with the same scale and child count `A`).
+    pub rules: Vec<Rule>,
+    /// `child_rule[rule][child]`: the rule a child subdivides with.
+    pub child_rule: Vec<Vec<u8>>,
+    /// `child_digit[rule][child]`: the child's rank among its siblings.
+    pub child_digit: Vec<Vec<u8>>,
+    /// Side of the root patch in cells: the roots cover `[0, side)^2`.
+    pub side: i32,
+    /// The root tiles.
+    pub roots: Vec<Placement>,
+    /// Rule of each root.
+    pub root_rule: Vec<u8>,
+    /// Code (rank) of each root, a permutation of `0..roots.len()`.
+    pub root_rank: Vec<u32>,
+    /// Structural index (automaton state) of each root.
+    pub root_class: Vec<u32>,
+    /// The automaton, row-major: `transitions[class * A + child]`.
+    pub transitions: Vec<u32>,
+    /// Importance bins per class; bin `b` was optimised for the density
+    /// fraction `A^(b / (bins - 1) - 1)` of a level's capacity (equal
+    /// ratios between bins: a fraction served by the bin above it misses
+    /// at most the same share of points everywhere).
+    pub bins: u16,
+    /// Offsets in the tile's frame (cells times [`PLANE_OFFSET_SCALE`]),
+    /// indexed `class * bins + bin`.
+    pub offsets: Vec<[i16; 2]>,
+}
+
+impl PlaneLut {
+    /// Children per tile (`A`).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{plane_lut, PlaneSystem};
+    /// assert_eq!(plane_lut(PlaneSystem::Ghexomino).arity(), 81);
+    /// ```
+    pub fn arity(&self) -> usize {
+        self.rules.first().map_or(0, |r| r.children.len())
+    }
+
+    /// Number of structural indices (automaton states).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{plane_lut, PlaneSystem};
+    /// assert!(plane_lut(PlaneSystem::Ppentomino).classes() > 1);
+    /// ```
+    pub fn classes(&self) -> usize {
+        self.transitions.len() / self.arity().max(1)
+    }
+
+    /// The density fraction (of a level's capacity) bin `bin` serves.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{plane_lut, PlaneSystem};
+    /// let lut = plane_lut(PlaneSystem::Ppentomino);
+    /// assert_eq!(lut.bin_fraction(lut.bins as usize - 1), 1.0);
+    /// assert_eq!(lut.bin_fraction(0), 0.25);
+    /// ```
+    pub fn bin_fraction(&self, bin: usize) -> f64 {
+        let a = self.arity() as f64;
+        a.powf(bin as f64 / (self.bins.max(2) - 1) as f64 - 1.0)
+    }
+
+    /// The offset (tile frame, cells) of class `class` in bin `bin`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{plane_lut, PlaneSystem};
+    /// let lut = plane_lut(PlaneSystem::Ppentomino);
+    /// let o = lut.offset(0, lut.bins as usize - 1);
+    /// assert!(lut.shape.contains(o));
+    /// ```
+    pub fn offset(&self, class: usize, bin: usize) -> [f64; 2] {
+        let [x, y] = self.offsets[class * self.bins as usize + bin];
+        [x as f64 / PLANE_OFFSET_SCALE, y as f64 / PLANE_OFFSET_SCALE]
+    }
+
+    /// Quantises an offset (cells) for storage.
+    pub(crate) fn quantise(offset: [f64; 2]) -> [i16; 2] {
+        offset.map(|v| {
+            (v * PLANE_OFFSET_SCALE)
+                .round()
+                .clamp(i16::MIN as f64, i16::MAX as f64) as i16
+        })
+    }
+
+    /// Decodes a table, checking its version and internal consistency.
+    ///
+    /// # Example
+    /// ```
+    /// assert!(tessera::lut::PlaneLut::from_bytes(&[1, 2, 3]).is_err());
+    /// ```
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, Error> {
+        let version = bytes.first().copied().unwrap_or(0) as u32;
+        if version != PLANE_LUT_VERSION {
+            return Err(Error::Table(format!(
+                "planar table has format version {version}, this build reads version {PLANE_LUT_VERSION}"
+            )));
+        }
+        let lut: PlaneLut = postcard::from_bytes(bytes)
+            .map_err(|e| Error::Table(format!("planar table does not decode: {e}")))?;
+        lut.validate()?;
+        Ok(lut)
+    }
+
+    /// Encodes the table.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
+    /// let lut = plane_lut(PlaneSystem::Ppentomino);
+    /// assert_eq!(PlaneLut::from_bytes(&lut.to_bytes()).unwrap(), *lut);
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        postcard::to_allocvec(self).expect("serialising to memory cannot fail")
+    }
+
+    /// Checks every index the run-time recursion will follow.
+    fn validate(&self) -> Result<(), Error> {
+        let bad = |what: &str| Err(Error::Table(format!("planar table: {what}")));
+        let a = self.arity();
+        let cells = self.shape.cells().len();
+        if !(2..=256).contains(&a) || !(1..=crate::tiling::plane::MAX_CELLS).contains(&cells) {
+            return bad("the shape needs 1..=8 cells and 2..=256 children per rule");
+        }
+        let scale = self.rules[0].scale;
+        if scale < 2 || (scale * scale) as usize != a {
+            return bad("a rule of scale s must have s^2 children");
+        }
+        if self
+            .rules
+            .iter()
+            .any(|r| r.scale != scale || r.children.len() != a || !r.tiles_parent(&self.shape))
+        {
+            return bad("every rule must tile its enlarged parent exactly");
+        }
+        let rules = self.rules.len();
+        if self.child_rule.len() != rules
+            || self.child_digit.len() != rules
+            || self
+                .child_rule
+                .iter()
+                .any(|r| r.len() != a || r.iter().any(|&x| x as usize >= rules))
+        {
+            return bad("child rule table has the wrong size or names a missing rule");
+        }
+        for digits in &self.child_digit {
+            let mut sorted = digits.clone();
+            sorted.sort_unstable();
+            if sorted.iter().enumerate().any(|(i, &d)| d as usize != i) {
+                return bad("child digits must be a permutation of 0..A");
+            }
+        }
+        let roots = self.roots.len();
+        if self.side <= 0
+            || roots == 0
+            || self.root_rule.len() != roots
+            || self.root_rank.len() != roots
+            || self.root_class.len() != roots
+            || self.root_rule.iter().any(|&r| r as usize >= rules)
+        {
+            return bad("root tables have the wrong size");
+        }
+        let mut covered: Vec<(i32, i32)> = self
+            .roots
+            .iter()
+            .flat_map(|p| p.cells(&self.shape).collect::<Vec<_>>())
+            .collect();
+        covered.sort_unstable();
+        let square: Vec<(i32, i32)> = (0..self.side)
+            .flat_map(|x| (0..self.side).map(move |y| (x, y)))
+            .collect();
+        if covered != square {
+            return bad("the roots must cover the square patch exactly once");
+        }
+        let mut ranks = self.root_rank.clone();
+        ranks.sort_unstable();
+        if ranks.iter().enumerate().any(|(i, &r)| r as usize != i) {
+            return bad("root ranks must be a permutation of 0..roots");
+        }
+        let classes = self.classes();
+        if self.transitions.len() != classes * a
+            || classes == 0
+            || self
+                .transitions
+                .iter()
+                .chain(&self.root_class)
+                .any(|&c| c as usize >= classes)
+        {
+            return bad("class automaton refers to a missing class");
+        }
+        if self.bins < 2 || self.offsets.len() != classes * self.bins as usize {
+            return bad("offset table has the wrong size");
+        }
+        Ok(())
+    }
+}
+
+/// The planar polyomino systems shipped in `luts/`.
+///
+/// # Example
+/// ```
+/// use tessera::lut::PlaneSystem;
+/// assert_eq!(PlaneSystem::Ghexomino.name(), "ghexomino");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PlaneSystem {
+    /// G-hexomino, 81-rep: 216 roots on a 36x36 patch, scale 9 per level.
+    Ghexomino,
+    /// P-pentomino, 4-rep: 20 roots on a 10x10 patch, scale 2 per level.
+    Ppentomino,
+}
+
+impl PlaneSystem {
+    /// The file stem in `luts/`.
+    ///
+    /// # Example
+    /// ```
+    /// assert_eq!(tessera::lut::PlaneSystem::Ppentomino.name(), "ppentomino");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            PlaneSystem::Ghexomino => "ghexomino",
+            PlaneSystem::Ppentomino => "ppentomino",
+        }
+    }
+}
+
+static GHEXOMINO_BYTES: &[u8] = include_bytes!("../luts/ghexomino.lut");
+static PPENTOMINO_BYTES: &[u8] = include_bytes!("../luts/ppentomino.lut");
+
+/// The planar table shipped in `luts/<system>.lut`, decoded once.
+///
+/// # Example
+/// ```
+/// use tessera::lut::{plane_lut, PlaneSystem};
+/// assert_eq!(plane_lut(PlaneSystem::Ghexomino).side, 36);
+/// ```
+pub fn plane_lut(system: PlaneSystem) -> Arc<PlaneLut> {
+    static LUTS: [OnceLock<Arc<PlaneLut>>; 2] = [OnceLock::new(), OnceLock::new()];
+    let (slot, bytes) = match system {
+        PlaneSystem::Ghexomino => (&LUTS[0], GHEXOMINO_BYTES),
+        PlaneSystem::Ppentomino => (&LUTS[1], PPENTOMINO_BYTES),
+    };
+    slot.get_or_init(|| {
+        Arc::new(
+            PlaneLut::from_bytes(bytes)
+                .expect("the embedded planar tables are checked by the test suite"),
         )
     })
     .clone()

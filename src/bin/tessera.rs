@@ -27,6 +27,8 @@ struct Cli {
 enum Command {
     /// Sample the unit sphere (HEALPix faces tiled by P-pentominoes).
     Sphere(SphereArgs),
+    /// Sample the unit square (G-hexomino or P-pentomino tilings).
+    Plane(PlaneArgs),
     /// Draw a tiling level and its samples as SVG.
     Tiles(TilesArgs),
     /// Build the offline tables in luts/.
@@ -116,6 +118,57 @@ enum UpAxis {
 #[derive(Clone, Copy, ValueEnum)]
 enum System {
     Sphere,
+    /// G-hexomino, 81-rep, on the unit square.
+    Ghexomino,
+    /// P-pentomino, 4-rep, on the unit square.
+    Ppentomino,
+}
+
+impl System {
+    /// The planar table of a planar system.
+    fn plane(self) -> Option<tessera::lut::PlaneSystem> {
+        match self {
+            System::Sphere => None,
+            System::Ghexomino => Some(tessera::lut::PlaneSystem::Ghexomino),
+            System::Ppentomino => Some(tessera::lut::PlaneSystem::Ppentomino),
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PlaneKind {
+    /// G-hexomino, 81-rep.
+    Ghexomino,
+    /// P-pentomino, 4-rep.
+    Ppentomino,
+}
+
+#[derive(Args)]
+struct PlaneArgs {
+    /// Tile system.
+    #[arg(long, value_enum)]
+    system: PlaneKind,
+    /// Importance: `uniform`, `ramp` (proportional to x) or `image:PATH`
+    /// (OpenEXR, Radiance .hdr or PNG; luminance as stored; x along the
+    /// columns, y down the rows from the file's first row).
+    #[arg(long, default_value = "uniform")]
+    density: String,
+    /// Sample the image's complement `max - value` (stippling: dark areas
+    /// get the points).
+    #[arg(long)]
+    invert: bool,
+    /// Number of samples (exact unless --expected).
+    #[arg(short = 'n', long = "count")]
+    count: usize,
+    /// Skip the exactness pass: return the natural count near N.
+    #[arg(long)]
+    expected: bool,
+    /// Output file, `-` for standard output.
+    #[arg(short, long, default_value = "-")]
+    output: PathBuf,
+    /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions).
+    #[arg(long, default_value = "txt")]
+    format: String,
 }
 
 #[derive(Args)]
@@ -165,14 +218,16 @@ struct LutBuildArgs {
     /// Seed of every random choice (the build is deterministic for a seed).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Lloyd iterations per level and importance bin.
-    #[arg(long, default_value_t = 32)]
-    iterations: usize,
-    /// Importance bins per structural index (6..=64): more bins leave fewer
+    /// Lloyd iterations per level and importance bin (default: 32 for the
+    /// sphere, 24 for the planar systems).
+    #[arg(long)]
+    iterations: Option<usize>,
+    /// Importance bins per structural index (default: 12 for the sphere, at
+    /// least 6; system-specific for the planar ones): more bins leave fewer
     /// holes between optimised densities, and make a larger table and a
     /// longer build.
-    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u8).range(6..=64))]
-    bins: u8,
+    #[arg(long)]
+    bins: Option<u16>,
     /// Directory to write `<system>.lut` and `<system>.provenance.json` into.
     #[arg(long, default_value = "luts")]
     out_dir: PathBuf,
@@ -191,6 +246,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Sphere(args) => sphere(args),
+        Command::Plane(args) => plane(args),
         Command::Tiles(args) => tiles(args),
         Command::Lut {
             command: LutCommand::Build(args),
@@ -319,43 +375,156 @@ fn print_report(points: &[glam::DVec3]) {
     );
 }
 
-fn tiles(args: TilesArgs) -> Result<(), Error> {
-    match args.system {
-        System::Sphere => {
-            if args.level > 5 {
-                return Err(Error::Request(format!(
-                    "level {} draws {} tiles; at most level 5 is drawn",
-                    args.level,
-                    240u64 << (2 * args.level)
-                )));
-            }
-            let tiling = SphereTiling::default();
-            let count = 240usize << (2 * args.level);
-            let points: Vec<glam::DVec3> =
-                engine::generate(&tiling, &tessera::density::Uniform, count, true)?
-                    .iter()
-                    .map(|s| s.position)
-                    .collect();
-            let svg = tessera::io::svg::sphere_tiles(&tiling, args.level, &points);
-            std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
+fn plane(args: PlaneArgs) -> Result<(), Error> {
+    use tessera::lut::PlaneSystem;
+    use tessera::tiling::plane::PlaneTiling;
+    let format: tessera::io::points::PlaneFormat = args.format.parse()?;
+    let density = tessera::density::plane::parse(&args.density, args.invert)?;
+    let tiling = PlaneTiling::new(tessera::lut::plane_lut(match args.system {
+        PlaneKind::Ghexomino => PlaneSystem::Ghexomino,
+        PlaneKind::Ppentomino => PlaneSystem::Ppentomino,
+    }));
+    let mut out = create(&args.output)?;
+    let written = match engine::stream(&tiling, args.count) {
+        // large uniform requests stream: memory stays O(depth)
+        Some(stream) if density.constant().is_some() && args.count > STREAM_ABOVE => {
+            tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format)
         }
+        _ => {
+            let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
+            tessera::io::points::write_plane(&mut out, samples.iter().map(|s| s.position), format)
+        }
+    };
+    written
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.output))
+}
+
+fn tiles(args: TilesArgs) -> Result<(), Error> {
+    let Some(system) = args.system.plane() else {
+        return sphere_tiles(args);
+    };
+    let tiling = tessera::tiling::plane::PlaneTiling::new(tessera::lut::plane_lut(system));
+    use tessera::tiling::TileSystem;
+    let count = tiling.capacity(args.level);
+    if count > 200_000.0 {
+        return Err(Error::Request(format!(
+            "level {} of the {} draws {count} tiles; at most 200000 are drawn",
+            args.level,
+            system.name()
+        )));
     }
+    let points: Vec<glam::DVec2> =
+        engine::generate(&tiling, &tessera::density::Uniform, count as usize, true)?
+            .iter()
+            .map(|s| s.position)
+            .collect();
+    let svg = tessera::io::svg::plane_tiles(&tiling, args.level, &points);
+    std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
+}
+
+fn sphere_tiles(args: TilesArgs) -> Result<(), Error> {
+    if args.level > 5 {
+        return Err(Error::Request(format!(
+            "level {} draws {} tiles; at most level 5 is drawn",
+            args.level,
+            240u64 << (2 * args.level)
+        )));
+    }
+    let tiling = SphereTiling::default();
+    let count = 240usize << (2 * args.level);
+    let points: Vec<glam::DVec3> =
+        engine::generate(&tiling, &tessera::density::Uniform, count, true)?
+            .iter()
+            .map(|s| s.position)
+            .collect();
+    let svg = tessera::io::svg::sphere_tiles(&tiling, args.level, &points);
+    std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
+}
+
+fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
+            .expect("static template"),
+    );
+    bar
+}
+
+fn write_table(
+    out_dir: &Path,
+    name: &str,
+    bytes: &[u8],
+    provenance: serde_json::Value,
+) -> Result<(PathBuf, PathBuf), Error> {
+    std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
+    let table = out_dir.join(format!("{name}.lut"));
+    std::fs::write(&table, bytes).map_err(io_error(&table))?;
+    let path = out_dir.join(format!("{name}.provenance.json"));
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&provenance).expect("json") + "\n",
+    )
+    .map_err(io_error(&path))?;
+    Ok((table, path))
+}
+
+fn plane_lut_build(args: &LutBuildArgs, system: tessera::lut::PlaneSystem) -> Result<(), Error> {
+    let mut options = tessera::optimize::plane::BuildOptions::for_system(system);
+    options.seed = args.seed;
+    if let Some(iterations) = args.iterations {
+        options.iterations = iterations;
+    }
+    if let Some(bins) = args.bins {
+        options.bins = bins;
+    }
+    let bar = progress_bar();
+    let progress = |stage: &str, done: u64, total: u64| {
+        bar.set_message(stage.to_string());
+        bar.set_length(total);
+        bar.set_position(done);
+    };
+    let started = std::time::Instant::now();
+    let (lut, report) = tessera::optimize::plane::build(system, &options, &progress)?;
+    bar.finish();
+    let seconds = started.elapsed().as_secs_f64();
+    let bytes = lut.to_bytes();
+    let provenance = serde_json::json!({
+        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        "tessera_version": env!("CARGO_PKG_VERSION"),
+        "format_version": lut.version,
+        "system": system.name(),
+        "options": options,
+        "build_seconds": seconds,
+        "report": report,
+        "table_bytes": bytes.len(),
+    });
+    let (table, path) = write_table(&args.out_dir, system.name(), &bytes, provenance)?;
+    eprintln!(
+        "wrote {} and {} in {seconds:.1} s",
+        table.display(),
+        path.display()
+    );
+    Ok(())
 }
 
 fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
-    match args.system {
-        System::Sphere => {
-            let options = tessera::optimize::sphere::BuildOptions {
+    match args.system.plane() {
+        Some(system) => plane_lut_build(&args, system),
+        None => {
+            let mut options = tessera::optimize::sphere::BuildOptions {
                 seed: args.seed,
-                iterations: args.iterations,
-                bins: args.bins,
                 ..Default::default()
             };
-            let bar = ProgressBar::new(1);
-            bar.set_style(
-                ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
-                    .expect("static template"),
-            );
+            if let Some(iterations) = args.iterations {
+                options.iterations = iterations;
+            }
+            if let Some(bins) = args.bins {
+                options.bins = u8::try_from(bins).map_err(|_| {
+                    Error::Request(format!("--bins {bins}: the sphere table holds at most 255"))
+                })?;
+            }
+            let bar = progress_bar();
             let progress = |stage: &str, done: u64, total: u64| {
                 bar.set_message(stage.to_string());
                 bar.set_length(total);
@@ -365,9 +534,7 @@ fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
             let (lut, report) = tessera::optimize::sphere::build(&options, &progress)?;
             bar.finish();
             let seconds = started.elapsed().as_secs_f64();
-            std::fs::create_dir_all(&args.out_dir).map_err(io_error(&args.out_dir))?;
-            let table = args.out_dir.join("sphere.lut");
-            std::fs::write(&table, lut.to_bytes()).map_err(io_error(&table))?;
+            let bytes = lut.to_bytes();
             let provenance = serde_json::json!({
                 "command": std::env::args().collect::<Vec<_>>().join(" "),
                 "tessera_version": env!("CARGO_PKG_VERSION"),
@@ -375,14 +542,9 @@ fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
                 "options": options,
                 "build_seconds": seconds,
                 "report": report,
-                "table_bytes": lut.to_bytes().len(),
+                "table_bytes": bytes.len(),
             });
-            let path = args.out_dir.join("sphere.provenance.json");
-            std::fs::write(
-                &path,
-                serde_json::to_string_pretty(&provenance).expect("json") + "\n",
-            )
-            .map_err(io_error(&path))?;
+            let (table, path) = write_table(&args.out_dir, "sphere", &bytes, provenance)?;
             eprintln!(
                 "wrote {} and {} in {seconds:.1} s",
                 table.display(),

@@ -6,6 +6,7 @@
 //! relative: only ratios matter, and the engine scales by the requested count.
 
 pub mod envmap;
+pub mod plane;
 pub mod region;
 pub mod sphere;
 

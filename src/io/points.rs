@@ -297,3 +297,70 @@ pub fn read_points(path: &Path, dims: usize) -> Result<Vec<Vec<f64>>, Error> {
         &path.display().to_string(),
     )
 }
+
+/// How planar samples are written.
+///
+/// # Example
+/// ```
+/// use tessera::io::points::PlaneFormat;
+/// assert_eq!("bin".parse::<PlaneFormat>().unwrap(), PlaneFormat::Bin);
+/// assert!("xyz".parse::<PlaneFormat>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneFormat {
+    /// `x y` per line (UTK text).
+    Txt,
+    /// UTK binary, 2 dimensions.
+    Bin,
+}
+
+impl std::str::FromStr for PlaneFormat {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        match s {
+            "txt" => Ok(PlaneFormat::Txt),
+            "bin" => Ok(PlaneFormat::Bin),
+            other => Err(Error::Request(format!(
+                "unknown planar format '{other}'; expected txt or bin"
+            ))),
+        }
+    }
+}
+
+/// Writes planar points in the given format.
+///
+/// # Example
+/// ```
+/// use tessera::io::points::{write_plane, PlaneFormat};
+/// let mut out = Vec::new();
+/// write_plane(&mut out, [glam::DVec2::new(0.5, 0.25)], PlaneFormat::Txt).unwrap();
+/// assert_eq!(String::from_utf8(out).unwrap(), "0.5 0.25\n");
+/// ```
+pub fn write_plane<I>(out: &mut impl Write, points: I, format: PlaneFormat) -> std::io::Result<()>
+where
+    I: IntoIterator<Item = glam::DVec2>,
+    I::IntoIter: ExactSizeIterator,
+{
+    let points = points.into_iter();
+    match format {
+        PlaneFormat::Txt => {
+            for p in points {
+                writeln!(out, "{} {}", p.x, p.y)?;
+            }
+        }
+        PlaneFormat::Bin => {
+            write_utk_header(out, points.len(), 2)?;
+            let mut buffer = Vec::with_capacity(16 << 12);
+            for p in points {
+                buffer.extend_from_slice(&p.x.to_le_bytes());
+                buffer.extend_from_slice(&p.y.to_le_bytes());
+                if buffer.len() >= 16 << 12 {
+                    out.write_all(&buffer)?;
+                    buffer.clear();
+                }
+            }
+            out.write_all(&buffer)?;
+        }
+    }
+    Ok(())
+}

@@ -102,3 +102,69 @@ fn unwrap_longitudes(lonlats: &mut [(f64, f64)]) {
         }
     }
 }
+
+/// Draws every tile of a planar polyomino level on the unit square (x to
+/// the right, y down as in images), filled by code rank (dark = kept
+/// first), labelled with its code when the level has at most 400 tiles,
+/// and the given points as dots.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::plane::PlaneTiling;
+/// let svg = tessera::io::svg::plane_tiles(&PlaneTiling::ppentomino(), 0, &[glam::DVec2::splat(0.5)]);
+/// assert_eq!(svg.matches("<polygon").count(), 20);
+/// assert_eq!(svg.matches("<text").count(), 20);
+/// ```
+pub fn plane_tiles(
+    tiling: &crate::tiling::plane::PlaneTiling,
+    level: u32,
+    points: &[glam::DVec2],
+) -> String {
+    let side = HEIGHT;
+    let tiles = tiling.tiles(level);
+    let capacity = tiling.capacity(level);
+    let outline = tiling.shape().outline();
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{side}" height="{side}" viewBox="0 0 {side} {side}">"#
+    );
+    let _ = writeln!(
+        svg,
+        r#"<rect width="{side}" height="{side}" fill="white"/>"#
+    );
+    let stroke = (side / tiling.cells_per_unit(level) / 8.0).clamp(0.1, 1.0);
+    let label = tiles.len() <= 400;
+    let font = side / tiling.cells_per_unit(level) * 0.8;
+    for tile in &tiles {
+        let mut path = String::new();
+        for &(x, y) in &outline {
+            let p = tiling.to_unit(tile, [x as f64, y as f64]) * side;
+            let _ = write!(path, "{:.2},{:.2} ", p.x, p.y);
+        }
+        let grey = (40.0 + 200.0 * tile.code as f64 / capacity) as u8;
+        let _ = writeln!(
+            svg,
+            r#"<polygon points="{path}" fill="rgb({grey},{grey},255)" stroke="black" stroke-width="{stroke:.2}"/>"#
+        );
+        if label {
+            let c = tiling.to_unit(tile, tiling.shape().centroid()) * side;
+            let _ = writeln!(
+                svg,
+                r#"<text x="{:.2}" y="{:.2}" font-size="{font:.2}" text-anchor="middle" dominant-baseline="middle">{}</text>"#,
+                c.x, c.y, tile.code
+            );
+        }
+    }
+    let radius = (side / tiling.cells_per_unit(level) / 4.0).max(0.6);
+    for p in points {
+        let _ = writeln!(
+            svg,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="{radius:.2}" fill="red"/>"#,
+            p.x * side,
+            p.y * side
+        );
+    }
+    svg.push_str("</svg>\n");
+    svg
+}

@@ -2,5 +2,6 @@
 //! produce the tables in `luts/`. Nothing here runs when sampling.
 
 pub mod exact_cover;
+pub mod plane;
 pub mod ranking;
 pub mod sphere;

@@ -4,6 +4,7 @@
 //! indices and offset tables; it knows nothing of densities or file formats.
 //! [`crate::engine`] drives any [`TileSystem`].
 
+pub mod plane;
 pub mod polyomino;
 pub mod sphere;
 

@@ -18,7 +18,28 @@ use serde::{Deserialize, Serialize};
 /// assert_eq!(quarter.then(quarter).then(quarter).then(quarter), Orientation::IDENTITY);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(try_from = "u8")]
 pub struct Orientation(u8);
+
+/// Tables store orientations as their index; an index outside `0..8` (a
+/// corrupt file) is refused when the table decodes, not met later.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::polyomino::Orientation;
+/// assert_eq!(Orientation::try_from(5).unwrap().index(), 5);
+/// assert!(Orientation::try_from(8).is_err());
+/// ```
+impl TryFrom<u8> for Orientation {
+    type Error = String;
+
+    fn try_from(index: u8) -> Result<Self, String> {
+        Orientation::ALL
+            .get(index as usize)
+            .copied()
+            .ok_or_else(|| format!("orientation index {index} is not in 0..8"))
+    }
+}
 
 impl Orientation {
     /// The identity.

@@ -1,0 +1,59 @@
+//! Planar throughput: tessera's polyomino systems at uniform density and on
+//! the ramp, one thread, against Bridson's Poisson-disk sampler
+//! (`fast_poisson`) in the same run. Run: `cargo bench --bench plane`.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use fast_poisson::Poisson2D;
+use std::hint::black_box;
+use tessera::density::{plane::Ramp, Uniform};
+use tessera::engine;
+use tessera::tiling::plane::PlaneTiling;
+
+const N: usize = 2_000_000;
+
+fn one_thread() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool")
+}
+
+fn systems() -> [(&'static str, PlaneTiling); 2] {
+    [
+        ("ghexomino", PlaneTiling::ghexomino()),
+        ("ppentomino", PlaneTiling::ppentomino()),
+    ]
+}
+
+/// Bridson with the radius that gives about `n` points in the unit square.
+fn bridson(n: usize, seed: u64) -> Vec<[f64; 2]> {
+    let radius = (0.7 / n as f64).sqrt();
+    Poisson2D::new()
+        .with_dimensions([1.0, 1.0], radius)
+        .with_seed(seed)
+        .generate()
+}
+
+fn throughput(c: &mut Criterion) {
+    let pool = one_thread();
+    let mut group = c.benchmark_group("plane_1_thread");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(N as u64));
+    for (name, tiling) in systems() {
+        group.bench_function(format!("{name}_uniform"), |b| {
+            b.iter(|| pool.install(|| black_box(engine::generate(&tiling, &Uniform, N, true))))
+        });
+        group.bench_function(format!("{name}_ramp"), |b| {
+            b.iter(|| pool.install(|| black_box(engine::generate(&tiling, &Ramp, N, true))))
+        });
+    }
+    let bridson_n = bridson(N / 10, 1).len();
+    group.throughput(Throughput::Elements(bridson_n as u64));
+    group.bench_function("bridson_fast_poisson", |b| {
+        b.iter(|| black_box(bridson(N / 10, 1)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, throughput);
+criterion_main!(benches);

@@ -1,0 +1,467 @@
+//! Planar polyomino tile systems on the unit square, driven by data.
+//!
+//! Any `A`-rep polyomino given as production rules (child placements in the
+//! parent's refined frame) becomes a tile system: a root patch of tiles
+//! covers `[0, side)^2` cells, mapped onto `[0, 1)^2`; each level refines the
+//! lattice by the rule's scale. Codes are base-`A` integers (a child's digit
+//! is its sibling rank, newest digit most significant, over the roots'
+//! ranks); structural indices follow the table's automaton; offsets come per
+//! (structural index, importance bin). Everything is in the table
+//! ([`PlaneLut`]); `tessera lut build --system ghexomino|ppentomino` makes it.
+//!
+//! The offsets were optimised on the torus (the root patch tiles the plane
+//! periodically), so a point pushed across the square's border re-enters on
+//! the opposite side: every point lies in `[0, 1)^2`.
+
+use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
+use crate::tiling::polyomino::{Placement, Shape};
+use crate::tiling::TileSystem;
+use glam::DVec2;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Most cells a planar rep-tile may have (the size of [`PlaneRegion::cells`]).
+pub const MAX_CELLS: usize = 8;
+
+/// A tile of a planar polyomino system.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+/// let t = PlaneTiling::ppentomino();
+/// assert_eq!(t.roots()[0].level, 0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlaneTile {
+    /// Position on the lattice of `side * scale^level` cells per unit.
+    pub placement: Placement,
+    /// Subdivision level.
+    pub level: u8,
+    /// The rule this tile's children follow.
+    pub rule: u8,
+    /// Structural index (automaton state).
+    pub class: u32,
+    /// Threshold code, `0..roots * A^level`.
+    pub code: u64,
+}
+
+/// A planar tile as a density sees it: its bounding box and cell centres in
+/// `[0, 1]^2`.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+/// let t = PlaneTiling::ppentomino();
+/// let r = t.region(&t.roots()[0]);
+/// assert_eq!(r.count, 5);
+/// assert!(r.lo.x >= 0.0 && r.hi.y <= 1.0);
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct PlaneRegion {
+    /// Lower corner of the bounding box.
+    pub lo: DVec2,
+    /// Upper corner of the bounding box.
+    pub hi: DVec2,
+    /// Side of one cell.
+    pub cell: f64,
+    /// Cell centres (the first `count`).
+    pub cells: [DVec2; MAX_CELLS],
+    /// Number of cells.
+    pub count: u8,
+}
+
+impl PlaneRegion {
+    /// The tile's cell centres.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+    /// let t = PlaneTiling::ghexomino();
+    /// assert_eq!(t.region(&t.roots()[0]).centres().len(), 6);
+    /// ```
+    pub fn centres(&self) -> &[DVec2] {
+        &self.cells[..self.count as usize]
+    }
+}
+
+/// A planar polyomino tile system driven by a [`PlaneLut`].
+///
+/// # Example
+/// ```
+/// use tessera::{engine, density::Uniform, tiling::plane::PlaneTiling};
+/// let s = engine::generate(&PlaneTiling::ghexomino(), &Uniform, 1000, true).unwrap();
+/// assert_eq!(s.len(), 1000);
+/// assert!(s.iter().all(|p| p.position.cmpge(glam::DVec2::ZERO).all()
+///     && p.position.cmplt(glam::DVec2::ONE).all()));
+/// ```
+#[derive(Clone)]
+pub struct PlaneTiling {
+    lut: Arc<PlaneLut>,
+    arity: usize,
+    scale: i32,
+    bins: usize,
+    max_level: u32,
+    roots_by_code: Vec<PlaneTile>,
+    /// `children[rule * A + child]`.
+    children: Vec<Placement>,
+    /// `child_rule[rule * A + child]`.
+    child_rule: Vec<u8>,
+    /// `child_digit[rule * A + child]`, as a `u64`.
+    child_digit: Vec<u64>,
+    /// `child_of_digit[rule * A + digit]`.
+    child_of_digit: Vec<u8>,
+    /// Decoded offsets, `class * bins + bin`.
+    offsets: Vec<[f64; 2]>,
+    /// The density fraction each bin was optimised for, increasing.
+    bin_fractions: Vec<f64>,
+    /// Roots times `A^level`: the weight of a level's new digit.
+    digit_weight: Vec<u64>,
+    /// `1 / (side * scale^level)`: lattice to unit square.
+    inv_size: Vec<f64>,
+}
+
+impl PlaneTiling {
+    /// A tiling driven by the given table.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{lut::{plane_lut, PlaneSystem}, tiling::plane::PlaneTiling};
+    /// let t = PlaneTiling::new(plane_lut(PlaneSystem::Ppentomino));
+    /// assert_eq!(t.lut().side, 10);
+    /// ```
+    pub fn new(lut: Arc<PlaneLut>) -> Self {
+        let arity = lut.arity();
+        let scale = lut.rules[0].scale;
+        let roots = lut.roots.len() as u64;
+        // deepest level whose codes fit u64 and lattice coordinates i32
+        let mut max_level = 0u32;
+        loop {
+            let next = max_level + 1;
+            let codes = (roots as u128) * (arity as u128).pow(next);
+            let size = lut.side as i128 * (scale as i128).pow(next) + 4 * scale as i128;
+            if codes > u64::MAX as u128 || size > i32::MAX as i128 {
+                break;
+            }
+            max_level = next;
+        }
+        let digit_weight = (0..=max_level)
+            .map(|l| roots * (arity as u64).pow(l))
+            .collect();
+        let inv_size = (0..=max_level)
+            .map(|l| 1.0 / (lut.side as f64 * (scale as f64).powi(l as i32)))
+            .collect();
+        let children = lut.rules.iter().flat_map(|r| r.children.clone()).collect();
+        let child_rule = lut.child_rule.concat();
+        let child_digit: Vec<u64> = lut.child_digit.concat().iter().map(|&d| d as u64).collect();
+        let mut child_of_digit = vec![0u8; child_digit.len()];
+        for (at, &d) in child_digit.iter().enumerate() {
+            let rule = at / arity;
+            child_of_digit[rule * arity + d as usize] = (at % arity) as u8;
+        }
+        let offsets = (0..lut.classes() * lut.bins as usize)
+            .map(|k| lut.offset(k / lut.bins as usize, k % lut.bins as usize))
+            .collect();
+        let bin_fractions = (0..lut.bins as usize)
+            .map(|b| lut.bin_fraction(b))
+            .collect();
+        let mut roots_by_code: Vec<PlaneTile> = (0..lut.roots.len())
+            .map(|r| PlaneTile {
+                placement: lut.roots[r],
+                level: 0,
+                rule: lut.root_rule[r],
+                class: lut.root_class[r],
+                code: lut.root_rank[r] as u64,
+            })
+            .collect();
+        roots_by_code.sort_by_key(|t| t.code);
+        PlaneTiling {
+            arity,
+            scale,
+            bins: lut.bins as usize,
+            max_level,
+            roots_by_code,
+            children,
+            child_rule,
+            child_digit,
+            child_of_digit,
+            offsets,
+            bin_fractions,
+            digit_weight,
+            inv_size,
+            lut,
+        }
+    }
+
+    /// The G-hexomino system (81-rep) with the table shipped in `luts/`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+    /// assert_eq!(PlaneTiling::ghexomino().capacity(1), 216.0 * 81.0);
+    /// ```
+    pub fn ghexomino() -> Self {
+        PlaneTiling::new(plane_lut(PlaneSystem::Ghexomino))
+    }
+
+    /// The P-pentomino system (4-rep) with the table shipped in `luts/`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+    /// assert_eq!(PlaneTiling::ppentomino().capacity(2), 320.0);
+    /// ```
+    pub fn ppentomino() -> Self {
+        PlaneTiling::new(plane_lut(PlaneSystem::Ppentomino))
+    }
+
+    /// The table driving this tiling.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::plane::PlaneTiling;
+    /// assert_eq!(PlaneTiling::ghexomino().lut().roots.len(), 216);
+    /// ```
+    pub fn lut(&self) -> &PlaneLut {
+        &self.lut
+    }
+
+    /// The rep-tile.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::plane::PlaneTiling;
+    /// assert_eq!(PlaneTiling::ppentomino().shape().cells().len(), 5);
+    /// ```
+    pub fn shape(&self) -> &Shape {
+        &self.lut.shape
+    }
+
+    /// Cells per unit length at `level` (the lattice resolution).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::plane::PlaneTiling;
+    /// assert_eq!(PlaneTiling::ppentomino().cells_per_unit(3), 80.0);
+    /// ```
+    pub fn cells_per_unit(&self, level: u32) -> f64 {
+        1.0 / self.inv_size[level.min(self.max_level) as usize]
+    }
+
+    /// Child `child` (rule order) of `tile`.
+    #[inline]
+    fn subdivide(&self, tile: &PlaneTile, child: usize) -> PlaneTile {
+        let at = tile.rule as usize * self.arity + child;
+        PlaneTile {
+            placement: tile.placement.child(&self.children[at], self.scale),
+            level: tile.level + 1,
+            rule: self.child_rule[at],
+            class: self.lut.transitions[tile.class as usize * self.arity + child],
+            code: tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize],
+        }
+    }
+
+    /// The child of `tile` carrying code digit `digit`.
+    #[inline]
+    fn child_with_digit(&self, tile: &PlaneTile, digit: usize) -> PlaneTile {
+        let child = self.child_of_digit[tile.rule as usize * self.arity + digit];
+        self.subdivide(tile, child as usize)
+    }
+
+    /// Every tile of a level, in tree order. `roots * A^level` tiles: meant
+    /// for small levels (drawings, the optimiser).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::plane::PlaneTiling;
+    /// assert_eq!(PlaneTiling::ppentomino().tiles(2).len(), 320);
+    /// ```
+    pub fn tiles(&self, level: u32) -> Vec<PlaneTile> {
+        let mut tiles: Vec<PlaneTile> = (0..self.lut.roots.len()).map(|r| self.root(r)).collect();
+        for _ in 0..level.min(self.max_level) {
+            tiles = tiles
+                .par_iter()
+                .flat_map_iter(|t| (0..self.arity).map(move |c| self.subdivide(t, c)))
+                .collect();
+        }
+        tiles
+    }
+
+    fn root(&self, r: usize) -> PlaneTile {
+        let lut = &*self.lut;
+        PlaneTile {
+            placement: lut.roots[r],
+            level: 0,
+            rule: lut.root_rule[r],
+            class: lut.root_class[r],
+            code: lut.root_rank[r] as u64,
+        }
+    }
+
+    /// The unit-square point of a point given in the tile's frame (cells),
+    /// not wrapped.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+    /// let t = PlaneTiling::ppentomino();
+    /// let p = t.to_unit(&t.roots()[0], [0.5, 0.5]);
+    /// assert!(p.x > 0.0 && p.x < 1.0);
+    /// ```
+    pub fn to_unit(&self, tile: &PlaneTile, local: [f64; 2]) -> DVec2 {
+        let [x, y] = tile.placement.to_lattice(local);
+        DVec2::new(x, y) * self.inv_size[tile.level as usize]
+    }
+
+    /// The importance bin serving density fraction `fraction` of a level's
+    /// capacity: the first bin optimised for at least that fraction, so the
+    /// tiles kept are a subset of those the bin was optimised with.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::plane::PlaneTiling;
+    /// let t = PlaneTiling::ppentomino();
+    /// assert_eq!(t.bin(1.0), t.lut().bins as usize - 1);
+    /// assert_eq!(t.bin(1e-9), 0);
+    /// ```
+    #[inline]
+    pub fn bin(&self, fraction: f64) -> usize {
+        // a relative tolerance keeps exact bin fractions in their own bin
+        let b = self
+            .bin_fractions
+            .partition_point(|&edge| edge * (1.0 + 1e-9) < fraction);
+        b.min(self.bins - 1)
+    }
+
+    #[inline]
+    fn position(&self, tile: &PlaneTile, bin: usize) -> DVec2 {
+        let [ox, oy] = self.offsets[tile.class as usize * self.bins + bin];
+        let m = tile.placement.orientation.matrix();
+        let (x0, y0) = tile.placement.origin;
+        let x = x0 as f64 + m[0][0] as f64 * ox + m[0][1] as f64 * oy;
+        let y = y0 as f64 + m[1][0] as f64 * ox + m[1][1] as f64 * oy;
+        let s = self.inv_size[tile.level as usize];
+        DVec2::new(wrap(x * s), wrap(y * s))
+    }
+}
+
+/// `v` mirrored into `[0, 1)` at the square's edges.
+#[inline]
+fn wrap(v: f64) -> f64 {
+    let w = if v < 0.0 {
+        -v
+    } else if v >= 1.0 {
+        2.0 - v
+    } else {
+        return v;
+    };
+    // offsets move points less than a root tile, so one mirror suffices;
+    // the largest f64 below 1 keeps the half-open square
+    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
+}
+
+impl TileSystem for PlaneTiling {
+    type Tile = PlaneTile;
+    type Point = DVec2;
+    type Region = PlaneRegion;
+
+    fn roots(&self) -> Vec<PlaneTile> {
+        (0..self.lut.roots.len()).map(|r| self.root(r)).collect()
+    }
+
+    fn child_count(&self, _: &PlaneTile) -> usize {
+        self.arity
+    }
+
+    fn child(&self, tile: &PlaneTile, i: usize) -> PlaneTile {
+        self.subdivide(tile, i)
+    }
+
+    fn level(&self, tile: &PlaneTile) -> u32 {
+        tile.level as u32
+    }
+
+    fn max_level(&self) -> u32 {
+        self.max_level
+    }
+
+    fn capacity(&self, level: u32) -> f64 {
+        self.lut.roots.len() as f64 * (self.arity as f64).powi(level as i32)
+    }
+
+    fn measure(&self) -> f64 {
+        1.0
+    }
+
+    fn code(&self, tile: &PlaneTile) -> u64 {
+        tile.code
+    }
+
+    fn region(&self, tile: &PlaneTile) -> PlaneRegion {
+        let s = self.inv_size[tile.level as usize];
+        let mut region = PlaneRegion {
+            lo: DVec2::INFINITY,
+            hi: DVec2::NEG_INFINITY,
+            cell: s,
+            cells: [DVec2::ZERO; MAX_CELLS],
+            count: 0,
+        };
+        for (k, (x, y)) in tile.placement.cells(&self.lut.shape).enumerate() {
+            let corner = DVec2::new(x as f64, y as f64) * s;
+            region.lo = region.lo.min(corner);
+            region.hi = region.hi.max(corner + s);
+            region.cells[k] = corner + 0.5 * s;
+            region.count += 1;
+        }
+        region
+    }
+
+    fn map_code_order<T: Send>(
+        &self,
+        level: u32,
+        count: usize,
+        f: &(dyn Fn(u64, &PlaneTile) -> T + Sync),
+    ) -> Option<Vec<T>> {
+        if level > self.max_level || count as f64 > self.capacity(level) {
+            return None;
+        }
+        if level == 0 {
+            let roots = self.roots_by_code[..count].iter().enumerate();
+            return Some(roots.map(|(code, t)| f(code as u64, t)).collect());
+        }
+        // codes `digit * m + c` share their parent with code `c` one level
+        // up: find the parents once, then every digit block from them
+        let m = self.digit_weight[level as usize - 1] as usize;
+        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
+        let mut out = Vec::with_capacity(count);
+        for digit in 0..self.arity {
+            let start = digit * m;
+            if start >= count {
+                break;
+            }
+            let block = parents[..(count - start).min(m)].par_iter().enumerate();
+            out.par_extend(
+                block.map(|(c, p)| f((start + c) as u64, &self.child_with_digit(p, digit))),
+            );
+        }
+        Some(out)
+    }
+
+    fn tile_with_code(&self, level: u32, code: u64) -> Option<PlaneTile> {
+        if level > self.max_level || code >= self.digit_weight[level as usize] {
+            return None;
+        }
+        let roots = self.roots_by_code.len() as u64;
+        let mut tile = self.roots_by_code[(code % roots) as usize];
+        let mut digits = code / roots;
+        for _ in 0..level {
+            let digit = (digits % self.arity as u64) as usize;
+            tile = self.child_with_digit(&tile, digit);
+            digits /= self.arity as u64;
+        }
+        Some(tile)
+    }
+
+    fn sample(&self, tile: &PlaneTile, fraction: f64) -> DVec2 {
+        self.position(tile, self.bin(fraction))
+    }
+}

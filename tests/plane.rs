@@ -1,0 +1,530 @@
+//! Planar polyomino systems: quality, density following, exactness,
+//! domain, determinism and the shipped tables.
+
+use glam::DVec2;
+use proptest::prelude::*;
+use tessera::baselines::SplitMix64;
+use tessera::density::plane::{Ramp, Raster};
+use tessera::density::{Density, Uniform};
+use tessera::engine;
+use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
+use tessera::metrics::plane::{low_frequency_power, min_distance, periodogram, radial_average};
+use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
+use tessera::tiling::TileSystem;
+
+fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
+    [
+        (PlaneSystem::Ghexomino, PlaneTiling::ghexomino()),
+        (PlaneSystem::Ppentomino, PlaneTiling::ppentomino()),
+    ]
+}
+
+fn positions<D: Density<PlaneRegion> + ?Sized>(t: &PlaneTiling, d: &D, n: usize) -> Vec<DVec2> {
+    engine::generate(t, d, n, true)
+        .unwrap()
+        .iter()
+        .map(|s| s.position)
+        .collect()
+}
+
+fn in_domain(p: &DVec2) -> bool {
+    (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)
+}
+
+#[test]
+fn uniform_4096_is_blue_noise() {
+    for (system, tiling) in systems() {
+        let points = positions(&tiling, &Uniform, 4096);
+        let d = min_distance(&points);
+        let low = low_frequency_power(&points);
+        // the largest peak of the radially averaged spectrum up to |k| = 128
+        let size = 256;
+        let radial = radial_average(&periodogram(&points, size), size);
+        let (peak_at, peak) = radial
+            .iter()
+            .enumerate()
+            .skip(1)
+            .fold((0, 0.0f64), |b, (r, &v)| if v > b.1 { (r, v) } else { b });
+        println!(
+            "{}: min distance {d:.3}, low-frequency power {low:.3}, radial peak {peak:.2} at |k| = {peak_at}",
+            system.name()
+        );
+        assert!(d >= 0.55, "{}: normalised min distance {d}", system.name());
+        assert!(low <= 0.10, "{}: low-frequency power {low}", system.name());
+    }
+}
+
+/// Counts per cell of a 16x16 grid against `expected(cell)`: every cell
+/// within 4 Poisson sigma (and 1 point of rounding).
+fn check_counts(points: &[DVec2], expected: impl Fn(usize, usize) -> f64, what: &str) {
+    let mut counts = [[0usize; 16]; 16];
+    for p in points {
+        counts[(p.y * 16.0) as usize][(p.x * 16.0) as usize] += 1;
+    }
+    for (row, line) in counts.iter().enumerate() {
+        for (col, &n) in line.iter().enumerate() {
+            let e = expected(col, row);
+            let sigma = e.sqrt().max(1.0);
+            assert!(
+                (n as f64 - e).abs() <= 4.0 * sigma + 1.0,
+                "{what}: cell ({col}, {row}) has {n} points, expected {e:.1}"
+            );
+        }
+    }
+}
+
+#[test]
+fn ramp_counts_follow_the_density() {
+    let n = 40_000;
+    for (system, tiling) in systems() {
+        let points = positions(&tiling, &Ramp, n);
+        assert_eq!(points.len(), n);
+        assert!(points.iter().all(in_domain));
+        // the ramp's mass over column c is (2c + 1) / 256 of the total
+        let expected = |col: usize, _| n as f64 * (2 * col + 1) as f64 / 256.0 / 16.0;
+        check_counts(&points, expected, system.name());
+    }
+}
+
+/// A photograph-like raster: smooth gradients, a bright disc, a dark
+/// square, texture and a few hot pixels, with a black band.
+fn photograph(width: usize, height: usize, seed: u64) -> Vec<f64> {
+    let mut rng = SplitMix64::new(seed);
+    let mut v = Vec::with_capacity(width * height);
+    for row in 0..height {
+        for col in 0..width {
+            let (x, y) = (col as f64 / width as f64, row as f64 / height as f64);
+            let mut g = 0.3 + 0.4 * x * (1.0 - y) + 0.1 * (12.0 * x).sin() * (9.0 * y).cos();
+            if (x - 0.65).powi(2) + (y - 0.35).powi(2) < 0.04 {
+                g += 0.5;
+            }
+            if (0.1..0.3).contains(&x) && (0.6..0.85).contains(&y) {
+                g *= 0.1;
+            }
+            g += 0.05 * rng.next_f64();
+            if rng.next_u64() % 4000 == 0 {
+                g = 1.0;
+            }
+            if row < height / 16 {
+                g = 0.0;
+            }
+            v.push(g.clamp(0.0, 1.0));
+        }
+    }
+    v
+}
+
+#[test]
+fn photograph_counts_follow_the_raster() {
+    let (w, h) = (96, 80);
+    let pixels = photograph(w, h, 7);
+    let raster = Raster::new(w, h, pixels.clone(), false).unwrap();
+    // the raster's exact mass per grid cell (pixels split between cells
+    // contribute by area)
+    let total: f64 = pixels.iter().sum();
+    let mass = |col: usize, row: usize| {
+        let mut m = 0.0;
+        for r in 0..h {
+            for c in 0..w {
+                let ox = overlap(c as f64 / w as f64, (c + 1) as f64 / w as f64, col);
+                let oy = overlap(r as f64 / h as f64, (r + 1) as f64 / h as f64, row);
+                m += pixels[r * w + c] * ox * oy;
+            }
+        }
+        m / total
+    };
+    let n = 30_000;
+    for (system, tiling) in systems() {
+        let points = positions(&tiling, &raster, n);
+        assert_eq!(points.len(), n);
+        assert!(points.iter().all(in_domain));
+        check_counts(&points, |c, r| n as f64 * mass(c, r), system.name());
+        // nothing lands in the black band at the top, except from tiles
+        // straddling its edge (tiles there are under 0.005 across)
+        let edge = (h / 16) as f64 / h as f64;
+        let deep = points.iter().filter(|p| p.y < edge - 0.005).count();
+        assert_eq!(
+            deep,
+            0,
+            "{}: {deep} points deep in the black band",
+            system.name()
+        );
+    }
+}
+
+fn overlap(a: f64, b: f64, cell: usize) -> f64 {
+    let (lo, hi) = (cell as f64 / 16.0, (cell + 1) as f64 / 16.0);
+    (b.min(hi) - a.max(lo)).max(0.0) / (b - a)
+}
+
+#[test]
+fn inverted_raster_puts_points_in_the_dark() {
+    // left half black, right half white: inverted, the samples go left
+    let raster = Raster::new(2, 1, vec![0.0, 1.0], true).unwrap();
+    for (_, tiling) in systems() {
+        let points = positions(&tiling, &raster, 500);
+        assert_eq!(points.len(), 500);
+        let right = points.iter().filter(|p| p.x >= 0.5).count();
+        assert!(right <= 5, "{right} points on the white side");
+    }
+}
+
+#[test]
+fn a_single_bright_pixel_is_not_skipped() {
+    let (w, h) = (256, 256);
+    let mut pixels = vec![1e-6; w * h];
+    pixels[200 * w + 37] = 1e6; // about 94 % of the mass
+    let raster = Raster::new(w, h, pixels, false).unwrap();
+    for (system, tiling) in systems() {
+        let points = positions(&tiling, &raster, 2000);
+        let inside = points
+            .iter()
+            .filter(|p| (p.x * w as f64) as usize == 37 && (p.y * h as f64) as usize == 200)
+            .count();
+        assert!(
+            inside > 1700,
+            "{}: {inside} of 2000 in the bright pixel",
+            system.name()
+        );
+    }
+}
+
+#[test]
+fn bad_rasters_are_refused_with_the_reason() {
+    for (w, h, v, why) in [
+        (0, 3, vec![], "0x3"),
+        (2, 2, vec![1.0; 3], "3 values"),
+        (1, 2, vec![1.0, f64::INFINITY], "row 1"),
+        (2, 1, vec![-1.0, 1.0], "non-negative"),
+        (2, 1, vec![0.0, 0.0], "zero"),
+    ] {
+        let e = Raster::new(w, h, v, false).unwrap_err().to_string();
+        assert!(e.contains("image") && e.contains(why), "{e}");
+    }
+    let e = Raster::new(2, 1, vec![1.0, 1.0], true)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("zero"), "{e}");
+}
+
+#[test]
+fn exact_counts_and_domain_for_small_and_odd_requests() {
+    for (_, tiling) in systems() {
+        for n in [0usize, 1, 2, 3, 17, 216, 217, 999, 5121, 17_497] {
+            for points in [
+                positions(&tiling, &Uniform, n),
+                positions(&tiling, &Ramp, n),
+            ] {
+                assert_eq!(points.len(), n);
+                assert!(points.iter().all(in_domain));
+            }
+        }
+    }
+}
+
+#[test]
+fn output_is_progressive() {
+    for (system, tiling) in systems() {
+        let points = positions(&tiling, &Uniform, 4096);
+        let full = min_distance(&points);
+        // a prefix is the set a smaller request keeps, placed with the
+        // offsets of the larger request's importance bin
+        for prefix in [1000, 2048, 3000] {
+            let d = min_distance(&points[..prefix]);
+            println!("{} prefix {prefix}: {d:.3} (full {full:.3})", system.name());
+            assert!(
+                d > 0.4 * full,
+                "{}: prefix {prefix} spread {d}",
+                system.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_samples() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            systems()
+                .iter()
+                .map(|(_, t)| {
+                    let u = engine::generate(t, &Uniform, 30_000, true).unwrap();
+                    let r = engine::generate(t, &Ramp, 5_000, true).unwrap();
+                    (u, r)
+                })
+                .collect::<Vec<_>>()
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn streaming_matches_generation() {
+    for (_, tiling) in systems() {
+        let streamed: Vec<DVec2> = engine::stream(&tiling, 20_000)
+            .unwrap()
+            .map(|s| s.position)
+            .collect();
+        assert_eq!(streamed, positions(&tiling, &Uniform, 20_000));
+    }
+}
+
+#[test]
+fn the_deepest_level_keeps_codes_and_points_apart() {
+    for (_, tiling) in systems() {
+        let level = tiling.max_level();
+        let lut = tiling.lut();
+        // exact: the f64 capacity rounds at these sizes
+        let cap = lut.roots.len() as u128 * (lut.arity() as u128).pow(level);
+        assert!(cap <= u64::MAX as u128);
+        // and the level is the deepest: one more overflows codes or lattice
+        let side = lut.side as i128 * (lut.rules[0].scale as i128).pow(level + 1);
+        assert!(cap * lut.arity() as u128 > u64::MAX as u128 || side > i32::MAX as i128 / 2);
+        let cap = cap as u64;
+        let mut seen = Vec::new();
+        for code in [0u64, 1, 2, cap / 2, cap - 1] {
+            let tile = tiling.tile_with_code(level, code).unwrap();
+            assert_eq!(tile.code, code);
+            let p = tiling.sample(&tile, 1.0);
+            assert!(in_domain(&p));
+            seen.push(p);
+        }
+        for i in 0..seen.len() {
+            for j in 0..i {
+                assert_ne!(seen[i], seen[j]);
+            }
+        }
+        assert!(tiling.tile_with_code(level, cap).is_none());
+        assert!(tiling.tile_with_code(level + 1, 0).is_none());
+    }
+}
+
+#[test]
+fn shipped_tables_are_small_and_round_trip() {
+    let mut total = 0;
+    for (system, _) in systems() {
+        let lut = plane_lut(system);
+        let bytes = lut.to_bytes();
+        total += bytes.len();
+        assert_eq!(PlaneLut::from_bytes(&bytes).unwrap(), *lut);
+        let path = format!("{}/luts/{}.lut", env!("CARGO_MANIFEST_DIR"), system.name());
+        assert_eq!(std::fs::read(path).unwrap(), bytes);
+        // truncated and version-bumped tables are refused
+        assert!(PlaneLut::from_bytes(&bytes[..bytes.len() / 2]).is_err());
+        let mut other = bytes.clone();
+        other[0] = 9;
+        assert!(PlaneLut::from_bytes(&other)
+            .unwrap_err()
+            .to_string()
+            .contains("version"));
+    }
+    assert!(total < 100_000, "planar tables take {total} bytes");
+}
+
+#[test]
+fn codes_of_a_level_are_a_permutation() {
+    for (_, tiling) in systems() {
+        let level = 1;
+        let mut codes: Vec<u64> = tiling.tiles(level).iter().map(|t| t.code).collect();
+        codes.sort_unstable();
+        assert!(codes.iter().enumerate().all(|(i, &c)| c == i as u64));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn tile_with_code_finds_the_tile_holding_the_code(code in 0u64..1_000_000) {
+        for (_, tiling) in systems() {
+            let level = (0..=tiling.max_level()).find(|&l| tiling.capacity(l) > code as f64).unwrap();
+            let tile = tiling.tile_with_code(level, code).unwrap();
+            prop_assert_eq!(tile.code, code);
+            prop_assert_eq!(tile.level as u32, level);
+        }
+    }
+
+    #[test]
+    fn raster_bounds_are_conservative(
+        w in 1usize..40, h in 1usize..40, seed in 0u64..1000, level in 0u32..3
+    ) {
+        let mut rng = SplitMix64::new(seed);
+        let pixels: Vec<f64> = (0..w * h).map(|_| rng.next_f64().powi(8)).collect();
+        let raster = Raster::new(w, h, pixels, false).unwrap();
+        let tiling = PlaneTiling::ppentomino();
+        for tile in tiling.tiles(level) {
+            let region = tiling.region(&tile);
+            let bound = raster.bound(&region);
+            let average = raster.average(&region);
+            // summed-area rounding: absolute, relative to the maximum (1)
+            prop_assert!(average <= bound + 1e-12);
+            for c in region.centres() {
+                for dx in [-0.49, 0.0, 0.49] {
+                    for dy in [-0.49, 0.0, 0.49] {
+                        let p = *c + DVec2::new(dx, dy) * region.cell;
+                        prop_assert!(raster.value(p) <= bound);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn tessera(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
+    for system in ["ghexomino", "ppentomino"] {
+        let out = tessera(&[
+            "plane",
+            "--system",
+            system,
+            "--density",
+            "ramp",
+            "-n",
+            "300",
+        ]);
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 300);
+        for line in text.lines() {
+            let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+            assert!(v.len() == 2 && in_domain(&DVec2::new(v[0], v[1])));
+        }
+        let bin = tessera(&["plane", "--system", system, "-n", "7", "--format", "bin"]).stdout;
+        assert_eq!(bin.len(), 20 + 7 * 16);
+        let rows = tessera::io::points::read_points_from(&bin[..], 2, "stdout").unwrap();
+        assert_eq!(rows.len(), 7);
+        let dir =
+            std::env::temp_dir().join(format!("tessera-plane-{system}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let svg = dir.join("tiles.svg");
+        let out = tessera(&[
+            "tiles",
+            "--system",
+            system,
+            "--level",
+            "1",
+            "--svg",
+            svg.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+        let drawing = std::fs::read_to_string(&svg).unwrap();
+        let tiles = plane_lut(if system == "ghexomino" {
+            PlaneSystem::Ghexomino
+        } else {
+            PlaneSystem::Ppentomino
+        })
+        .roots
+        .len()
+            * if system == "ghexomino" { 81 } else { 4 };
+        assert_eq!(drawing.matches("<polygon").count(), tiles);
+        assert_eq!(drawing.matches("<circle").count(), tiles);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    for (args, why) in [
+        (
+            &[
+                "plane",
+                "--system",
+                "ppentomino",
+                "--density",
+                "cap:1",
+                "-n",
+                "5",
+            ][..],
+            "cap:1",
+        ),
+        (
+            &[
+                "plane",
+                "--system",
+                "ppentomino",
+                "-n",
+                "5",
+                "--format",
+                "xyz",
+            ][..],
+            "xyz",
+        ),
+        (
+            &[
+                "tiles",
+                "--system",
+                "ghexomino",
+                "--level",
+                "3",
+                "--svg",
+                "/tmp/x.svg",
+            ][..],
+            "level 3",
+        ),
+    ] {
+        let out = tessera(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(why), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn cli_samples_a_png_file_and_its_inverse() {
+    // a generated 64x32 grey PNG: black left half, white right half
+    let dir = std::env::temp_dir().join(format!("tessera-plane-png-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("half.png");
+    let image =
+        image::GrayImage::from_fn(64, 32, |x, _| image::Luma([if x < 32 { 0 } else { 255 }]));
+    image.save(&path).unwrap();
+    let spec = format!("image:{}", path.display());
+    for (invert, left) in [(false, false), (true, true)] {
+        let mut args = vec![
+            "plane",
+            "--system",
+            "ppentomino",
+            "--density",
+            &spec,
+            "-n",
+            "2000",
+        ];
+        if invert {
+            args.push("--invert");
+        }
+        let out = tessera(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 2000);
+        for line in text.lines() {
+            let x: f64 = line.split(' ').next().unwrap().parse().unwrap();
+            // zero importance gets no point: the black half, or under
+            // --invert the white one
+            assert_eq!(x < 0.5, left, "invert {invert}: x = {x}");
+        }
+    }
+    let out = tessera(&[
+        "plane",
+        "--system",
+        "ppentomino",
+        "--density",
+        "image:/no/such.png",
+        "-n",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.png"));
+    let out = tessera(&["plane", "--system", "ppentomino", "--invert", "-n", "5"]);
+    assert_eq!(out.status.code(), Some(1));
+}
