@@ -165,10 +165,12 @@ where
 /// Generates about `count` samples (exactly `count` when `exact`) following
 /// `density`, in progressive order.
 ///
-/// Exactness: the magnitude is first set so that the expected count is
-/// `count`; if fewer samples come out it is raised and the recursion re-run,
-/// then the `count` samples of smallest rank are kept, which is a
-/// progressive prefix, never a spatially truncated set.
+/// Exactness: the magnitude is first set a little above `count` (by
+/// `2 sqrt(count)`, several times the spread of the natural count), so a
+/// single pass almost always finds enough; if fewer samples still come out
+/// it is raised and the recursion re-run. The `count` samples of smallest
+/// rank are kept, which is a progressive prefix, never a spatially
+/// truncated set.
 ///
 /// # Example
 /// ```
@@ -216,7 +218,12 @@ where
             return Ok(samples);
         }
     }
-    let mut magnitude = count as f64;
+    // the safety margin of an exact request (see above)
+    let mut magnitude = if exact {
+        count as f64 + 2.0 * (count as f64).sqrt()
+    } else {
+        count as f64
+    };
     let mut parts = collect_parts(system, density, magnitude);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
@@ -238,13 +245,67 @@ where
             total(&parts)
         )));
     }
-    // stable, so ties keep their deterministic root order
-    let mut samples = parts.concat();
-    samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
-    if exact {
-        samples.truncate(count);
+    Ok(by_rank(parts, if exact { count } else { usize::MAX }))
+}
+
+/// The `keep` samples of smallest rank (all when fewer), ordered by rank;
+/// ties keep their deterministic root order (as a stable sort would).
+fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Vec<Sample<P>> {
+    let samples = parts.concat();
+    // (rank as an unsigned key ordered like `f64::total_cmp`, position in
+    // root order): distinct keys, so any sort of them is deterministic
+    let mut keys: Vec<(u64, usize)> = samples
+        .par_iter()
+        .enumerate()
+        .map(|(i, s)| (total_order_key(s.rank), i))
+        .collect();
+    radix_sort(&mut keys);
+    keys.truncate(keep);
+    keys.par_iter().map(|&(_, i)| samples[i]).collect()
+}
+
+/// An unsigned key ordered like [`f64::total_cmp`].
+fn total_order_key(x: f64) -> u64 {
+    let bits = x.to_bits();
+    if bits >> 63 == 1 {
+        !bits
+    } else {
+        bits | 1 << 63
     }
-    Ok(samples)
+}
+
+/// Stable least-significant-digit radix sort by the key, 8 bits a pass,
+/// skipping the passes where every key has the same digit (the exponent
+/// bytes of ranks in `[0, 1)` mostly agree).
+fn radix_sort(keys: &mut Vec<(u64, usize)>) {
+    if keys.len() < 256 {
+        keys.sort_unstable();
+        return;
+    }
+    let mut counts = vec![[0usize; 256]; 8];
+    for &(k, _) in keys.iter() {
+        for (pass, c) in counts.iter_mut().enumerate() {
+            c[(k >> (8 * pass)) as usize & 255] += 1;
+        }
+    }
+    let mut buffer = vec![(0u64, 0usize); keys.len()];
+    for (pass, c) in counts.iter().enumerate() {
+        if c.iter().any(|&n| n == keys.len()) {
+            continue; // one digit for all: the pass keeps the order
+        }
+        let mut start = [0usize; 256];
+        let mut sum = 0;
+        for (s, &n) in start.iter_mut().zip(c) {
+            *s = sum;
+            sum += n;
+        }
+        for &(k, i) in keys.iter() {
+            let d = (k >> (8 * pass)) as usize & 255;
+            buffer[start[d]] = (k, i);
+            start[d] += 1;
+        }
+        std::mem::swap(keys, &mut buffer);
+    }
 }
 
 /// Uniform samples in progressive order, computed one at a time from their

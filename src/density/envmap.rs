@@ -249,6 +249,17 @@ impl Edges {
     }
 }
 
+/// `x.floor() as i64` without a libm call (NaN gives 0, as the cast does).
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
+}
+
 /// Largest error (rad) of [`fast_atan2`], checked by a unit test.
 const FAST_ATAN2_ERROR: f64 = 2e-5;
 
@@ -310,6 +321,9 @@ pub struct EnvMap {
     /// Sampling frame to world: the engine samples `value(p) = map(rotation p)`
     /// and samples are reported at `rotation p`.
     rotation: DMat3,
+    /// Z up and no rotation: face points are looked up from their `(z, phi)`
+    /// directly, without building the direction.
+    plain: bool,
 }
 
 impl EnvMap {
@@ -364,6 +378,7 @@ impl EnvMap {
             }),
             up,
             rotation: DMat3::IDENTITY,
+            plain: up == Up::Z,
         })
     }
 
@@ -412,6 +427,7 @@ impl EnvMap {
         .normalize();
         EnvMap {
             rotation: DMat3::from_quat(q),
+            plain: false,
             ..self.clone()
         }
     }
@@ -607,18 +623,42 @@ impl EnvMap {
         } else {
             s.asin()
         } + FAST_ATAN2_ERROR;
-        let c0 = ((phi - half) / TAU * w).floor() as i64;
-        let c1 = ((phi + half) / TAU * w).floor() as i64;
-        if c1 - c0 + 1 >= px.width as i64 {
+        let c0 = floor_i64((phi - half) / TAU * w);
+        let c1 = floor_i64((phi + half) / TAU * w);
+        let width = px.width as i64;
+        if c1 - c0 + 1 >= width {
             return (j0, j1, 0, px.width - 1);
         }
-        let wrap = |c: i64| c.rem_euclid(px.width as i64) as usize;
+        // phi in [0, 2 pi) and half below pi: at most one turn out
+        let wrap = |c: i64| {
+            if c < 0 {
+                (c + width) as usize
+            } else if c >= width {
+                (c - width) as usize
+            } else {
+                c as usize
+            }
+        };
         (j0, j1, wrap(c0), wrap(c1))
     }
 
     /// The value in the sampling frame.
     fn at(&self, p: DVec3) -> f64 {
         self.radiance(self.rotation * p)
+    }
+
+    /// The value at a face point in the sampling frame; without a rotation
+    /// or axis swap, from its `(z, phi)` without trigonometry.
+    #[inline]
+    fn at_face_point(&self, p: FacePoint) -> f64 {
+        if !self.plain {
+            return self.at(p.to_vec());
+        }
+        let px = &*self.pixels;
+        let (z, phi) = p.z_phi();
+        let j = px.edges.row(z).min(px.height - 1);
+        let i = ((phi * (px.width as f64 / TAU)) as usize).min(px.width - 1);
+        px.values[j * px.width + i]
     }
 }
 
@@ -649,10 +689,15 @@ impl Density<SphereRegion> for EnvMap {
     }
 
     fn average(&self, region: &SphereRegion) -> f64 {
-        let (j0, j1, c0, c1) = self.touched(region);
-        if j0 == j1 && c0 == c1 {
-            // the tile lies in one pixel: its value is the exact average
-            return self.pixels.values[j0 * self.pixels.width + c0];
+        // a cap at least a pixel row across always touches two rows (or,
+        // clamped at a pole, every column): only smaller caps may lie in
+        // one pixel
+        if 2.0 * region.radius < PI / self.pixels.height as f64 || self.pixels.width == 1 {
+            let (j0, j1, c0, c1) = self.touched(region);
+            if j0 == j1 && c0 == c1 {
+                // the tile lies in one pixel: its value is the exact average
+                return self.pixels.values[j0 * self.pixels.width + c0];
+            }
         }
         let side = cell_side(&region.cells);
         // pixel rows per cell side (a face side is about 1.02 rad)
@@ -665,7 +710,7 @@ impl Density<SphereRegion> for EnvMap {
                 for b in 0..n {
                     let x = cx + side * ((a as f64 + 0.5) / n as f64 - 0.5);
                     let y = cy + side * ((b as f64 + 0.5) / n as f64 - 0.5);
-                    sum += self.at(FacePoint::new(region.face, x, y).to_vec());
+                    sum += self.at_face_point(FacePoint::new(region.face, x, y));
                 }
             }
         }

@@ -116,6 +116,8 @@ pub struct SphereTiling {
     child_of_digit: [[u8; 4]; 2],
     /// The density fraction each importance bin was optimised for.
     bin_fractions: Vec<f64>,
+    /// `shape.centroid()`, cached for [`TileSystem::region`].
+    centroid: [f64; 2],
 }
 
 impl Default for SphereTiling {
@@ -141,6 +143,7 @@ impl SphereTiling {
             roots_by_code: Vec::new(),
             child_of_digit: [[0; 4]; 2],
             bin_fractions: Vec::new(),
+            centroid: Shape::p_pentomino().centroid(),
         };
         let bins = tiling.lut.bins as usize;
         tiling.bin_fractions = (0..bins)
@@ -307,7 +310,12 @@ impl TileSystem for SphereTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        ROOT_COUNT as f64 * 4f64.powi(level as i32)
+        if level <= MAX_LEVEL {
+            // 240 * 4^26 < 2^60: exact in u64, and in f64 (a power of two times 15)
+            ((ROOT_COUNT as u64) << (2 * level)) as f64
+        } else {
+            ROOT_COUNT as f64 * 4f64.powi(level as i32)
+        }
     }
 
     fn code(&self, tile: &SphereTile) -> u64 {
@@ -315,7 +323,7 @@ impl TileSystem for SphereTiling {
     }
 
     fn region(&self, tile: &SphereTile) -> SphereRegion {
-        let centroid = self.shape.centroid();
+        let centroid = self.centroid;
         let cell = |i: usize| {
             let (cx, cy) = self.shape.cells()[i];
             let p = self.face_point(tile, [cx as f64 + 0.5, cy as f64 + 0.5]);
