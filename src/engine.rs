@@ -111,11 +111,12 @@ where
         if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
             return;
         }
-        let (bound, region) = match self.constant {
-            Some(c) => (c, None),
+        let (bound, average, region) = match self.constant {
+            Some(c) => (c, Some(c), None),
             None => {
                 let region = self.system.region(tile);
-                (self.density.bound(&region), Some(region))
+                let (bound, average) = self.density.bound_and_average(&region);
+                (bound, average, Some(region))
             }
         };
         let bound = self.magnitude * (bound / self.mean);
@@ -127,10 +128,15 @@ where
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
             }
-            let d = match (self.constant, &region) {
-                (Some(_), _) => self.magnitude,
-                (None, Some(r)) => self.magnitude * (self.density.average(r) / self.mean),
-                (None, None) => unreachable!("a region exists whenever the density varies"),
+            let d = match (self.constant, average, &region) {
+                (Some(_), _, _) => self.magnitude,
+                (None, Some(a), _) => self.magnitude * (a / self.mean),
+                (None, None, Some(r)) => {
+                    self.magnitude * (self.density.average_after_bound(r) / self.mean)
+                }
+                (None, None, None) => {
+                    unreachable!("a region exists whenever the density varies")
+                }
             };
             // a tile's code threshold sits mid-way through its unit of
             // density, so sparse regions round instead of always keeping code 0

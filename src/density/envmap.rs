@@ -96,6 +96,9 @@ struct Pixels {
     /// Level `l >= 1` holds the maximum over `2^l x 2^l` pixel blocks.
     max_levels: Vec<OnceLock<Vec<f64>>>,
     edges: Edges,
+    /// `height / pi` and `width / (2 pi)`.
+    rows_per_rad: f64,
+    cols_per_rad: f64,
 }
 
 impl Pixels {
@@ -291,13 +294,6 @@ fn fast_atan2(y: f64, x: f64) -> f64 {
     }
 }
 
-/// `(theta, phi)` of a Z-up direction by [`fast_atan2`], `phi` in `[0, 2 pi)`.
-fn fast_angles(m: DVec3) -> (f64, f64) {
-    let theta = fast_atan2((m.x * m.x + m.y * m.y).sqrt(), m.z);
-    let phi = fast_atan2(m.y, m.x);
-    (theta, if phi < 0.0 { phi + TAU } else { phi })
-}
-
 /// A lat-long HDR environment map as a density on the sphere (see the
 /// [module docs](self) for the convention). Cloning is cheap (the pixels
 /// and pyramid are shared).
@@ -375,6 +371,8 @@ impl EnvMap {
                 integral,
                 max_levels: (0..levels).map(|_| OnceLock::new()).collect(),
                 edges: Edges::new(w, h),
+                rows_per_rad: h as f64 / PI,
+                cols_per_rad: w as f64 / TAU,
             }),
             up,
             rotation: DMat3::IDENTITY,
@@ -602,17 +600,24 @@ impl EnvMap {
     /// touches every column.
     fn touched(&self, region: &SphereRegion) -> (usize, usize, usize, usize) {
         let px = &*self.pixels;
-        let (w, h) = (px.width as f64, px.height as f64);
-        let m = self.up.to_map(self.rotation * region.center);
-        let (theta, phi) = fast_angles(m);
+        let m = if self.plain {
+            region.center
+        } else {
+            self.up.to_map(self.rotation * region.center)
+        };
+        let rxy = (m.x * m.x + m.y * m.y).sqrt();
+        let theta = fast_atan2(rxy, m.z);
+        let phi = fast_atan2(m.y, m.x);
+        let phi = if phi < 0.0 { phi + TAU } else { phi };
         // wider than the cap by the angles' error, so pixel edges never
         // round inwards
         let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
-        let j1 = (((theta + r) / PI * h) as usize).min(px.height - 1);
-        let j0 = (((theta - r).max(0.0) / PI * h) as usize).min(j1);
+        let (rows_per_rad, cols_per_rad) = (px.rows_per_rad, px.cols_per_rad);
+        let j1 = (((theta + r) * rows_per_rad) as usize).min(px.height - 1);
+        let j0 = (((theta - r).max(0.0) * rows_per_rad) as usize).min(j1);
         // sin(theta) of the unit vector without trigonometry, a hair low;
         // r >= sin r, so `s` bounds sin r / sin theta from above
-        let sin_theta = (m.x * m.x + m.y * m.y).sqrt() * (1.0 - 1e-12);
+        let sin_theta = rxy * (1.0 - 1e-12);
         let s = r / sin_theta;
         if theta - r <= 0.0 || theta + r >= PI || s >= 1.0 || s.is_nan() {
             return (j0, j1, 0, px.width - 1);
@@ -623,8 +628,8 @@ impl EnvMap {
         } else {
             s.asin()
         } + FAST_ATAN2_ERROR;
-        let c0 = floor_i64((phi - half) / TAU * w);
-        let c1 = floor_i64((phi + half) / TAU * w);
+        let c0 = floor_i64((phi - half) * cols_per_rad);
+        let c1 = floor_i64((phi + half) * cols_per_rad);
         let width = px.width as i64;
         if c1 - c0 + 1 >= width {
             return (j0, j1, 0, px.width - 1);
@@ -657,7 +662,7 @@ impl EnvMap {
         let px = &*self.pixels;
         let (z, phi) = p.z_phi();
         let j = px.edges.row(z).min(px.height - 1);
-        let i = ((phi * (px.width as f64 / TAU)) as usize).min(px.width - 1);
+        let i = ((phi * px.cols_per_rad) as usize).min(px.width - 1);
         px.values[j * px.width + i]
     }
 }
@@ -677,15 +682,58 @@ fn cell_side(cells: &[[f64; 2]; 5]) -> f64 {
     side
 }
 
-impl Density<SphereRegion> for EnvMap {
-    fn bound(&self, region: &SphereRegion) -> f64 {
+impl EnvMap {
+    /// The maximum over the pixels a region touches, and the pixel's value
+    /// when it touches only one (then the region's exact average).
+    fn bound_in(&self, region: &SphereRegion) -> (f64, Option<f64>) {
         let px = &*self.pixels;
         match self.touched(region) {
-            (j0, j1, c0, c1) if c0 <= c1 => px.max_over(j0, j1, c0, c1),
-            (j0, j1, c0, c1) => px
-                .max_over(j0, j1, c0, px.width - 1)
-                .max(px.max_over(j0, j1, 0, c1)),
+            (j0, j1, c0, c1) if j0 == j1 && c0 == c1 => {
+                let v = px.values[j0 * px.width + c0];
+                (v, Some(v))
+            }
+            (j0, j1, c0, c1) if c0 <= c1 => (px.max_over(j0, j1, c0, c1), None),
+            (j0, j1, c0, c1) => (
+                px.max_over(j0, j1, c0, px.width - 1)
+                    .max(px.max_over(j0, j1, 0, c1)),
+                None,
+            ),
         }
+    }
+
+    /// The midpoint rule over equal-area sub-cells about a pixel row across.
+    fn quadrature(&self, region: &SphereRegion) -> f64 {
+        let side = cell_side(&region.cells);
+        // pixel rows per cell side (a face side is about 1.02 rad)
+        let rows = side * 1.02 / (PI / self.pixels.height as f64);
+        // sub-cells at most about a pixel row across
+        let n = (rows.ceil() as usize).clamp(1, 8);
+        let mut sum = 0.0;
+        if n == 1 {
+            for [cx, cy] in region.cells {
+                sum += self.at_face_point(FacePoint::new(region.face, cx, cy));
+            }
+            return sum / 5.0;
+        }
+        let mut offsets = [0.0f64; 8];
+        for (a, o) in offsets.iter_mut().enumerate().take(n) {
+            *o = side * ((a as f64 + 0.5) / n as f64 - 0.5);
+        }
+        let offsets = &offsets[..n];
+        for [cx, cy] in region.cells {
+            for &da in offsets {
+                for &db in offsets {
+                    sum += self.at_face_point(FacePoint::new(region.face, cx + da, cy + db));
+                }
+            }
+        }
+        sum / (5 * n * n) as f64
+    }
+}
+
+impl Density<SphereRegion> for EnvMap {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        self.bound_in(region).0
     }
 
     fn average(&self, region: &SphereRegion) -> f64 {
@@ -699,22 +747,15 @@ impl Density<SphereRegion> for EnvMap {
                 return self.pixels.values[j0 * self.pixels.width + c0];
             }
         }
-        let side = cell_side(&region.cells);
-        // pixel rows per cell side (a face side is about 1.02 rad)
-        let rows = side * 1.02 / (PI / self.pixels.height as f64);
-        // sub-cells at most about a pixel row across
-        let n = (rows.ceil() as usize).clamp(1, 8);
-        let mut sum = 0.0;
-        for [cx, cy] in region.cells {
-            for a in 0..n {
-                for b in 0..n {
-                    let x = cx + side * ((a as f64 + 0.5) / n as f64 - 0.5);
-                    let y = cy + side * ((b as f64 + 0.5) / n as f64 - 0.5);
-                    sum += self.at_face_point(FacePoint::new(region.face, x, y));
-                }
-            }
-        }
-        sum / (5 * n * n) as f64
+        self.quadrature(region)
+    }
+
+    fn bound_and_average(&self, region: &SphereRegion) -> (f64, Option<f64>) {
+        self.bound_in(region)
+    }
+
+    fn average_after_bound(&self, region: &SphereRegion) -> f64 {
+        self.quadrature(region)
     }
 
     fn value(&self, point: DVec3) -> f64 {
