@@ -162,7 +162,13 @@ where
                 return;
             }
         }
+        // children the bound already rejects (see `visit`'s first test) are
+        // skipped before they are built
+        let child_rejects = self.system.capacity(level + 1) >= bound;
         for i in 0..self.system.child_count(tile) {
+            if child_rejects && self.system.child_code(tile, i) as f64 + 0.5 >= bound {
+                continue;
+            }
             self.visit(&self.system.child(tile, i), bound, out);
         }
     }
@@ -265,7 +271,11 @@ fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Ve
         .enumerate()
         .map(|(i, s)| (total_order_key(s.rank), i))
         .collect();
-    radix_sort(&mut keys);
+    if samples.iter().all(|s| (0.0..1.0).contains(&s.rank)) {
+        bucket_sort(&mut keys, |i| samples[i].rank);
+    } else {
+        radix_sort(&mut keys);
+    }
     keys.truncate(keep);
     keys.par_iter().map(|&(_, i)| samples[i]).collect()
 }
@@ -278,6 +288,39 @@ fn total_order_key(x: f64) -> u64 {
     } else {
         bits | 1 << 63
     }
+}
+
+/// Sorts distinct keys of ranks in `[0, 1)` (what the engine's ranks
+/// are: `code / d` with `code + 1/2 < d`): one bucket per key by the rank's
+/// value, which is monotone in it, then each (typically tiny) bucket by key.
+fn bucket_sort(keys: &mut Vec<(u64, usize)>, rank: impl Fn(usize) -> f64) {
+    let n = keys.len();
+    if n < 256 {
+        keys.sort_unstable();
+        return;
+    }
+    let bucket = |i: usize| ((rank(i) * n as f64) as usize).min(n - 1);
+    let mut start = vec![0usize; n + 1];
+    for &(_, i) in keys.iter() {
+        start[bucket(i) + 1] += 1;
+    }
+    for b in 0..n {
+        start[b + 1] += start[b];
+    }
+    let mut sorted = vec![(0u64, 0usize); n];
+    let mut next = start.clone();
+    for &(k, i) in keys.iter() {
+        let b = bucket(i);
+        sorted[next[b]] = (k, i);
+        next[b] += 1;
+    }
+    for b in 0..n {
+        let (lo, hi) = (start[b], start[b + 1]);
+        if hi - lo > 1 {
+            sorted[lo..hi].sort_unstable();
+        }
+    }
+    *keys = sorted;
 }
 
 /// Stable least-significant-digit radix sort by the key, 8 bits a pass,

@@ -322,6 +322,11 @@ impl TileSystem for SphereTiling {
         tile.code
     }
 
+    fn child_code(&self, tile: &SphereTile, i: usize) -> u64 {
+        let digit = self.lut.child_digit[tile.rule as usize][i] as u64;
+        tile.code + digit * ((ROOT_COUNT as u64) << (2 * tile.level as u32))
+    }
+
     fn region(&self, tile: &SphereTile) -> SphereRegion {
         let centroid = self.centroid;
         let cell = |i: usize| {
