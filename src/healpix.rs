@@ -145,7 +145,7 @@ impl FacePoint {
     /// assert!((z - v.z).abs() < 1e-15);
     /// assert!((phi - v.y.atan2(v.x).rem_euclid(std::f64::consts::TAU)).abs() < 1e-14);
     /// ```
-    #[inline]
+    #[inline(always)]
     pub fn z_phi(self) -> (f64, f64) {
         match self.zone() {
             Ok((z, _, a)) => {
@@ -165,7 +165,7 @@ impl FacePoint {
 
     /// `(z, sin(theta), longitude inside the face's quadrant)`, or the
     /// direction itself at a pole (NaN for NaN coordinates).
-    #[inline]
+    #[inline(always)]
     fn zone(self) -> Result<(f64, f64, f64), DVec3> {
         let face = self.face % FACE_COUNT as u8;
         let x = self.x.clamp(0.0, 1.0);

@@ -654,7 +654,7 @@ impl EnvMap {
 
     /// The value at a face point in the sampling frame; without a rotation
     /// or axis swap, from its `(z, phi)` without trigonometry.
-    #[inline]
+    #[inline(always)]
     fn at_face_point(&self, p: FacePoint) -> f64 {
         if !self.plain {
             return self.at(p.to_vec());
