@@ -264,6 +264,16 @@ where
 /// ties keep their deterministic root order (as a stable sort would).
 fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Vec<Sample<P>> {
     let samples = parts.concat();
+    if samples.len() < u32::MAX as usize
+        && samples.iter().all(|s| (0.0..1.0).contains(&s.rank))
+    {
+        let order = bucket_order(&samples);
+        let keep = keep.min(order.len());
+        return order[..keep]
+            .par_iter()
+            .map(|&i| samples[i as usize])
+            .collect();
+    }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in
     // root order): distinct keys, so any sort of them is deterministic
     let mut keys: Vec<(u64, usize)> = samples
@@ -271,13 +281,42 @@ fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Ve
         .enumerate()
         .map(|(i, s)| (total_order_key(s.rank), i))
         .collect();
-    if samples.iter().all(|s| (0.0..1.0).contains(&s.rank)) {
-        bucket_sort(&mut keys, |i| samples[i].rank);
-    } else {
-        radix_sort(&mut keys);
-    }
+    radix_sort(&mut keys);
     keys.truncate(keep);
     keys.par_iter().map(|&(_, i)| samples[i]).collect()
+}
+
+/// The positions of samples with ranks in `[0, 1)` (what the engine's
+/// ranks are: `code / d` with `code + 1/2 < d`) in rank order, ties in
+/// position order: one bucket per sample by the rank's value (monotone in
+/// it), then each (typically tiny) bucket by rank and position.
+fn bucket_order<P>(samples: &[Sample<P>]) -> Vec<u32> {
+    let n = samples.len();
+    let bucket = |s: &Sample<P>| ((s.rank * n as f64) as usize).min(n.saturating_sub(1));
+    let mut start = vec![0u32; n + 1];
+    for s in samples {
+        start[bucket(s) + 1] += 1;
+    }
+    for b in 0..n {
+        start[b + 1] += start[b];
+    }
+    let mut order = vec![0u32; n];
+    // `start[b]` moves to the end of bucket b while filling, which is the
+    // start of bucket b + 1 before filling
+    for (i, s) in samples.iter().enumerate() {
+        let b = bucket(s);
+        order[start[b] as usize] = i as u32;
+        start[b] += 1;
+    }
+    let mut lo = 0;
+    for &hi in &start[..n] {
+        let hi = hi as usize;
+        if hi - lo > 1 {
+            order[lo..hi].sort_unstable_by_key(|&i| (total_order_key(samples[i as usize].rank), i));
+        }
+        lo = hi;
+    }
+    order
 }
 
 /// An unsigned key ordered like [`f64::total_cmp`].
@@ -288,39 +327,6 @@ fn total_order_key(x: f64) -> u64 {
     } else {
         bits | 1 << 63
     }
-}
-
-/// Sorts distinct keys of ranks in `[0, 1)` (what the engine's ranks
-/// are: `code / d` with `code + 1/2 < d`): one bucket per key by the rank's
-/// value, which is monotone in it, then each (typically tiny) bucket by key.
-fn bucket_sort(keys: &mut Vec<(u64, usize)>, rank: impl Fn(usize) -> f64) {
-    let n = keys.len();
-    if n < 256 {
-        keys.sort_unstable();
-        return;
-    }
-    let bucket = |i: usize| ((rank(i) * n as f64) as usize).min(n - 1);
-    let mut start = vec![0usize; n + 1];
-    for &(_, i) in keys.iter() {
-        start[bucket(i) + 1] += 1;
-    }
-    for b in 0..n {
-        start[b + 1] += start[b];
-    }
-    let mut sorted = vec![(0u64, 0usize); n];
-    let mut next = start.clone();
-    for &(k, i) in keys.iter() {
-        let b = bucket(i);
-        sorted[next[b]] = (k, i);
-        next[b] += 1;
-    }
-    for b in 0..n {
-        let (lo, hi) = (start[b], start[b + 1]);
-        if hi - lo > 1 {
-            sorted[lo..hi].sort_unstable();
-        }
-    }
-    *keys = sorted;
 }
 
 /// Stable least-significant-digit radix sort by the key, 8 bits a pass,
