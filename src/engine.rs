@@ -264,9 +264,7 @@ where
 /// ties keep their deterministic root order (as a stable sort would).
 fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Vec<Sample<P>> {
     let samples = parts.concat();
-    if samples.len() < u32::MAX as usize
-        && samples.iter().all(|s| (0.0..1.0).contains(&s.rank))
-    {
+    if samples.len() < u32::MAX as usize && samples.iter().all(|s| (0.0..1.0).contains(&s.rank)) {
         let order = bucket_order(&samples);
         let keep = keep.min(order.len());
         return order[..keep]
@@ -345,7 +343,7 @@ fn radix_sort(keys: &mut Vec<(u64, usize)>) {
     }
     let mut buffer = vec![(0u64, 0usize); keys.len()];
     for (pass, c) in counts.iter().enumerate() {
-        if c.iter().any(|&n| n == keys.len()) {
+        if c.contains(&keys.len()) {
             continue; // one digit for all: the pass keeps the order
         }
         let mut start = [0usize; 256];
