@@ -707,7 +707,9 @@ impl EnvMap {
         // pixel rows per cell side (a face side is about 1.02 rad)
         let rows = side * 1.02 / (PI / self.pixels.height as f64);
         // sub-cells at most about a pixel row across
-        let n = (rows.ceil() as usize).clamp(1, 8);
+        // `rows.ceil()` without a libm call (NaN gives 0 either way)
+        let whole = rows as usize;
+        let n = (whole + usize::from((whole as f64) < rows)).clamp(1, 8);
         let mut sum = 0.0;
         if n == 1 {
             for [cx, cy] in region.cells {
