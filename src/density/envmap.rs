@@ -566,8 +566,10 @@ impl EnvMap {
     pub fn generate(&self, count: usize) -> Result<Vec<crate::Sample<DVec3>>, Error> {
         let tiling = crate::tiling::sphere::SphereTiling::default();
         let mut samples = crate::engine::generate(&tiling, self, count, true)?;
-        for s in &mut samples {
-            s.position = self.to_world(s.position);
+        if self.rotation != DMat3::IDENTITY {
+            for s in &mut samples {
+                s.position = self.to_world(s.position);
+            }
         }
         Ok(samples)
     }
@@ -649,6 +651,10 @@ impl EnvMap {
 
     /// The value in the sampling frame.
     fn at(&self, p: DVec3) -> f64 {
+        if self.plain {
+            // Z up, identity frame: the world direction is `p` itself
+            return self.radiance(p);
+        }
         self.radiance(self.rotation * p)
     }
 
