@@ -111,11 +111,12 @@ where
         if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
             return;
         }
-        let (bound, region) = match self.constant {
-            Some(c) => (c, None),
+        let (bound, average, region) = match self.constant {
+            Some(c) => (c, Some(c), None),
             None => {
                 let region = self.system.region(tile);
-                (self.density.bound(&region), Some(region))
+                let (bound, average) = self.density.bound_and_average(&region);
+                (bound, average, Some(region))
             }
         };
         let bound = self.magnitude * (bound / self.mean);
@@ -127,10 +128,15 @@ where
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
             }
-            let d = match (self.constant, &region) {
-                (Some(_), _) => self.magnitude,
-                (None, Some(r)) => self.magnitude * (self.density.average(r) / self.mean),
-                (None, None) => unreachable!("a region exists whenever the density varies"),
+            let d = match (self.constant, average, &region) {
+                (Some(_), _, _) => self.magnitude,
+                (None, Some(a), _) => self.magnitude * (a / self.mean),
+                (None, None, Some(r)) => {
+                    self.magnitude * (self.density.average_after_bound(r) / self.mean)
+                }
+                (None, None, None) => {
+                    unreachable!("a region exists whenever the density varies")
+                }
             };
             // a tile's code threshold sits mid-way through its unit of
             // density, so sparse regions round instead of always keeping code 0
@@ -156,7 +162,13 @@ where
                 return;
             }
         }
+        // children the bound already rejects (see `visit`'s first test) are
+        // skipped before they are built
+        let child_rejects = self.system.capacity(level + 1) >= bound;
         for i in 0..self.system.child_count(tile) {
+            if child_rejects && self.system.child_code(tile, i) as f64 + 0.5 >= bound {
+                continue;
+            }
             self.visit(&self.system.child(tile, i), bound, out);
         }
     }
@@ -165,10 +177,12 @@ where
 /// Generates about `count` samples (exactly `count` when `exact`) following
 /// `density`, in progressive order.
 ///
-/// Exactness: the magnitude is first set so that the expected count is
-/// `count`; if fewer samples come out it is raised and the recursion re-run,
-/// then the `count` samples of smallest rank are kept, which is a
-/// progressive prefix, never a spatially truncated set.
+/// Exactness: the magnitude is first set a little above `count` (by
+/// `2 sqrt(count)`, several times the spread of the natural count), so a
+/// single pass almost always finds enough; if fewer samples still come out
+/// it is raised and the recursion re-run. The `count` samples of smallest
+/// rank are kept, which is a progressive prefix, never a spatially
+/// truncated set.
 ///
 /// # Example
 /// ```
@@ -216,7 +230,12 @@ where
             return Ok(samples);
         }
     }
-    let mut magnitude = count as f64;
+    // the safety margin of an exact request (see above)
+    let mut magnitude = if exact {
+        count as f64 + 2.0 * (count as f64).sqrt()
+    } else {
+        count as f64
+    };
     let mut parts = collect_parts(system, density, magnitude);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
@@ -238,13 +257,108 @@ where
             total(&parts)
         )));
     }
-    // stable, so ties keep their deterministic root order
-    let mut samples = parts.concat();
-    samples.par_sort_by(|a, b| a.rank.total_cmp(&b.rank));
-    if exact {
-        samples.truncate(count);
+    Ok(by_rank(parts, if exact { count } else { usize::MAX }))
+}
+
+/// The `keep` samples of smallest rank (all when fewer), ordered by rank;
+/// ties keep their deterministic root order (as a stable sort would).
+fn by_rank<P: Copy + Send + Sync>(parts: Vec<Vec<Sample<P>>>, keep: usize) -> Vec<Sample<P>> {
+    let samples = parts.concat();
+    if samples.len() < u32::MAX as usize && samples.iter().all(|s| (0.0..1.0).contains(&s.rank)) {
+        let order = bucket_order(&samples);
+        let keep = keep.min(order.len());
+        return order[..keep]
+            .par_iter()
+            .map(|&i| samples[i as usize])
+            .collect();
     }
-    Ok(samples)
+    // (rank as an unsigned key ordered like `f64::total_cmp`, position in
+    // root order): distinct keys, so any sort of them is deterministic
+    let mut keys: Vec<(u64, usize)> = samples
+        .par_iter()
+        .enumerate()
+        .map(|(i, s)| (total_order_key(s.rank), i))
+        .collect();
+    radix_sort(&mut keys);
+    keys.truncate(keep);
+    keys.par_iter().map(|&(_, i)| samples[i]).collect()
+}
+
+/// The positions of samples with ranks in `[0, 1)` (what the engine's
+/// ranks are: `code / d` with `code + 1/2 < d`) in rank order, ties in
+/// position order: one bucket per sample by the rank's value (monotone in
+/// it), then each (typically tiny) bucket by rank and position.
+fn bucket_order<P>(samples: &[Sample<P>]) -> Vec<u32> {
+    let n = samples.len();
+    let bucket = |s: &Sample<P>| ((s.rank * n as f64) as usize).min(n.saturating_sub(1));
+    let mut start = vec![0u32; n + 1];
+    for s in samples {
+        start[bucket(s) + 1] += 1;
+    }
+    for b in 0..n {
+        start[b + 1] += start[b];
+    }
+    let mut order = vec![0u32; n];
+    // `start[b]` moves to the end of bucket b while filling, which is the
+    // start of bucket b + 1 before filling
+    for (i, s) in samples.iter().enumerate() {
+        let b = bucket(s);
+        order[start[b] as usize] = i as u32;
+        start[b] += 1;
+    }
+    let mut lo = 0;
+    for &hi in &start[..n] {
+        let hi = hi as usize;
+        if hi - lo > 1 {
+            order[lo..hi].sort_unstable_by_key(|&i| (total_order_key(samples[i as usize].rank), i));
+        }
+        lo = hi;
+    }
+    order
+}
+
+/// An unsigned key ordered like [`f64::total_cmp`].
+fn total_order_key(x: f64) -> u64 {
+    let bits = x.to_bits();
+    if bits >> 63 == 1 {
+        !bits
+    } else {
+        bits | 1 << 63
+    }
+}
+
+/// Stable least-significant-digit radix sort by the key, 8 bits a pass,
+/// skipping the passes where every key has the same digit (the exponent
+/// bytes of ranks in `[0, 1)` mostly agree).
+fn radix_sort(keys: &mut Vec<(u64, usize)>) {
+    if keys.len() < 256 {
+        keys.sort_unstable();
+        return;
+    }
+    let mut counts = vec![[0usize; 256]; 8];
+    for &(k, _) in keys.iter() {
+        for (pass, c) in counts.iter_mut().enumerate() {
+            c[(k >> (8 * pass)) as usize & 255] += 1;
+        }
+    }
+    let mut buffer = vec![(0u64, 0usize); keys.len()];
+    for (pass, c) in counts.iter().enumerate() {
+        if c.contains(&keys.len()) {
+            continue; // one digit for all: the pass keeps the order
+        }
+        let mut start = [0usize; 256];
+        let mut sum = 0;
+        for (s, &n) in start.iter_mut().zip(c) {
+            *s = sum;
+            sum += n;
+        }
+        for &(k, i) in keys.iter() {
+            let d = (k >> (8 * pass)) as usize & 255;
+            buffer[start[d]] = (k, i);
+            start[d] += 1;
+        }
+        std::mem::swap(keys, &mut buffer);
+    }
 }
 
 /// Uniform samples in progressive order, computed one at a time from their

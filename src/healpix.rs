@@ -122,11 +122,56 @@ impl FacePoint {
     /// assert_eq!(FacePoint::new(9, 0.0, 0.0).to_vec(), -glam::DVec3::Z);
     /// ```
     pub fn to_vec(self) -> DVec3 {
+        match self.zone() {
+            Ok((z, sin_theta, a)) => {
+                let (s, c) = a.sin_cos();
+                let (cx, cy) = rotate_quarter_turns(c, s, (self.face % FACE_COUNT as u8) % 4);
+                DVec3::new(sin_theta * cx, sin_theta * cy, z)
+            }
+            Err(v) => v,
+        }
+    }
+
+    /// `(z, phi)` of [`FacePoint::to_vec`]'s direction without trigonometry:
+    /// `z = cos(theta)`, `phi` in `[0, 2 pi)` (0 at the poles, NaN for NaN
+    /// coordinates).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::new(5, 0.3, 0.6);
+    /// let (z, phi) = p.z_phi();
+    /// let v = p.to_vec();
+    /// assert!((z - v.z).abs() < 1e-15);
+    /// assert!((phi - v.y.atan2(v.x).rem_euclid(std::f64::consts::TAU)).abs() < 1e-14);
+    /// ```
+    #[inline(always)]
+    pub fn z_phi(self) -> (f64, f64) {
+        match self.zone() {
+            Ok((z, _, a)) => {
+                let phi = a + FRAC_PI_2 * ((self.face % FACE_COUNT as u8) % 4) as f64;
+                let phi = if phi < 0.0 {
+                    phi + TAU
+                } else if phi >= TAU {
+                    phi - TAU
+                } else {
+                    phi
+                };
+                (z, phi)
+            }
+            Err(v) => (v.z, if v.z.is_nan() { f64::NAN } else { 0.0 }),
+        }
+    }
+
+    /// `(z, sin(theta), longitude inside the face's quadrant)`, or the
+    /// direction itself at a pole (NaN for NaN coordinates).
+    #[inline(always)]
+    fn zone(self) -> Result<(f64, f64, f64), DVec3> {
         let face = self.face % FACE_COUNT as u8;
         let x = self.x.clamp(0.0, 1.0);
         let y = self.y.clamp(0.0, 1.0);
         // (z, sin(theta), longitude inside the quadrant starting at k pi / 2)
-        let (z, sin_theta, a) = match face / 4 {
+        Ok(match face / 4 {
             0 => {
                 let sigma = (1.0 - x) + (1.0 - y);
                 if sigma >= 1.0 {
@@ -137,9 +182,9 @@ impl FacePoint {
                     let sin_theta = sigma * ((1.0 + z) / 3.0).sqrt();
                     (z, sin_theta, FRAC_PI_2 * ((1.0 - y) / sigma))
                 } else if sigma == 0.0 {
-                    return DVec3::Z;
+                    return Err(DVec3::Z);
                 } else {
-                    return DVec3::NAN;
+                    return Err(DVec3::NAN);
                 }
             }
             1 => equatorial_zone(x + y - 1.0, FRAC_PI_4 * (x - y)),
@@ -153,15 +198,12 @@ impl FacePoint {
                     let sin_theta = sigma * ((1.0 + abs_z) / 3.0).sqrt();
                     (-abs_z, sin_theta, FRAC_PI_2 * (x / sigma))
                 } else if sigma == 0.0 {
-                    return DVec3::NEG_Z;
+                    return Err(DVec3::NEG_Z);
                 } else {
-                    return DVec3::NAN;
+                    return Err(DVec3::NAN);
                 }
             }
-        };
-        let (s, c) = a.sin_cos();
-        let (cx, cy) = rotate_quarter_turns(c, s, face % 4);
-        DVec3::new(sin_theta * cx, sin_theta * cy, z)
+        })
     }
 
     /// Maps a direction to its face point. `v` need not be normalised but must be non-zero and

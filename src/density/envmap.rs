@@ -96,6 +96,9 @@ struct Pixels {
     /// Level `l >= 1` holds the maximum over `2^l x 2^l` pixel blocks.
     max_levels: Vec<OnceLock<Vec<f64>>>,
     edges: Edges,
+    /// `height / pi` and `width / (2 pi)`.
+    rows_per_rad: f64,
+    cols_per_rad: f64,
 }
 
 impl Pixels {
@@ -249,6 +252,17 @@ impl Edges {
     }
 }
 
+/// `x.floor() as i64` without a libm call (NaN gives 0, as the cast does).
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
+}
+
 /// Largest error (rad) of [`fast_atan2`], checked by a unit test.
 const FAST_ATAN2_ERROR: f64 = 2e-5;
 
@@ -280,13 +294,6 @@ fn fast_atan2(y: f64, x: f64) -> f64 {
     }
 }
 
-/// `(theta, phi)` of a Z-up direction by [`fast_atan2`], `phi` in `[0, 2 pi)`.
-fn fast_angles(m: DVec3) -> (f64, f64) {
-    let theta = fast_atan2((m.x * m.x + m.y * m.y).sqrt(), m.z);
-    let phi = fast_atan2(m.y, m.x);
-    (theta, if phi < 0.0 { phi + TAU } else { phi })
-}
-
 /// A lat-long HDR environment map as a density on the sphere (see the
 /// [module docs](self) for the convention). Cloning is cheap (the pixels
 /// and pyramid are shared).
@@ -310,6 +317,9 @@ pub struct EnvMap {
     /// Sampling frame to world: the engine samples `value(p) = map(rotation p)`
     /// and samples are reported at `rotation p`.
     rotation: DMat3,
+    /// Z up and no rotation: face points are looked up from their `(z, phi)`
+    /// directly, without building the direction.
+    plain: bool,
 }
 
 impl EnvMap {
@@ -361,9 +371,12 @@ impl EnvMap {
                 integral,
                 max_levels: (0..levels).map(|_| OnceLock::new()).collect(),
                 edges: Edges::new(w, h),
+                rows_per_rad: h as f64 / PI,
+                cols_per_rad: w as f64 / TAU,
             }),
             up,
             rotation: DMat3::IDENTITY,
+            plain: up == Up::Z,
         })
     }
 
@@ -412,6 +425,7 @@ impl EnvMap {
         .normalize();
         EnvMap {
             rotation: DMat3::from_quat(q),
+            plain: false,
             ..self.clone()
         }
     }
@@ -552,8 +566,10 @@ impl EnvMap {
     pub fn generate(&self, count: usize) -> Result<Vec<crate::Sample<DVec3>>, Error> {
         let tiling = crate::tiling::sphere::SphereTiling::default();
         let mut samples = crate::engine::generate(&tiling, self, count, true)?;
-        for s in &mut samples {
-            s.position = self.to_world(s.position);
+        if self.rotation != DMat3::IDENTITY {
+            for s in &mut samples {
+                s.position = self.to_world(s.position);
+            }
         }
         Ok(samples)
     }
@@ -586,17 +602,24 @@ impl EnvMap {
     /// touches every column.
     fn touched(&self, region: &SphereRegion) -> (usize, usize, usize, usize) {
         let px = &*self.pixels;
-        let (w, h) = (px.width as f64, px.height as f64);
-        let m = self.up.to_map(self.rotation * region.center);
-        let (theta, phi) = fast_angles(m);
+        let m = if self.plain {
+            region.center
+        } else {
+            self.up.to_map(self.rotation * region.center)
+        };
+        let rxy = (m.x * m.x + m.y * m.y).sqrt();
+        let theta = fast_atan2(rxy, m.z);
+        let phi = fast_atan2(m.y, m.x);
+        let phi = if phi < 0.0 { phi + TAU } else { phi };
         // wider than the cap by the angles' error, so pixel edges never
         // round inwards
         let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
-        let j1 = (((theta + r) / PI * h) as usize).min(px.height - 1);
-        let j0 = (((theta - r).max(0.0) / PI * h) as usize).min(j1);
+        let (rows_per_rad, cols_per_rad) = (px.rows_per_rad, px.cols_per_rad);
+        let j1 = (((theta + r) * rows_per_rad) as usize).min(px.height - 1);
+        let j0 = (((theta - r).max(0.0) * rows_per_rad) as usize).min(j1);
         // sin(theta) of the unit vector without trigonometry, a hair low;
         // r >= sin r, so `s` bounds sin r / sin theta from above
-        let sin_theta = (m.x * m.x + m.y * m.y).sqrt() * (1.0 - 1e-12);
+        let sin_theta = rxy * (1.0 - 1e-12);
         let s = r / sin_theta;
         if theta - r <= 0.0 || theta + r >= PI || s >= 1.0 || s.is_nan() {
             return (j0, j1, 0, px.width - 1);
@@ -607,18 +630,46 @@ impl EnvMap {
         } else {
             s.asin()
         } + FAST_ATAN2_ERROR;
-        let c0 = ((phi - half) / TAU * w).floor() as i64;
-        let c1 = ((phi + half) / TAU * w).floor() as i64;
-        if c1 - c0 + 1 >= px.width as i64 {
+        let c0 = floor_i64((phi - half) * cols_per_rad);
+        let c1 = floor_i64((phi + half) * cols_per_rad);
+        let width = px.width as i64;
+        if c1 - c0 + 1 >= width {
             return (j0, j1, 0, px.width - 1);
         }
-        let wrap = |c: i64| c.rem_euclid(px.width as i64) as usize;
+        // phi in [0, 2 pi) and half below pi: at most one turn out
+        let wrap = |c: i64| {
+            if c < 0 {
+                (c + width) as usize
+            } else if c >= width {
+                (c - width) as usize
+            } else {
+                c as usize
+            }
+        };
         (j0, j1, wrap(c0), wrap(c1))
     }
 
     /// The value in the sampling frame.
     fn at(&self, p: DVec3) -> f64 {
+        if self.plain {
+            // Z up, identity frame: the world direction is `p` itself
+            return self.radiance(p);
+        }
         self.radiance(self.rotation * p)
+    }
+
+    /// The value at a face point in the sampling frame; without a rotation
+    /// or axis swap, from its `(z, phi)` without trigonometry.
+    #[inline(always)]
+    fn at_face_point(&self, p: FacePoint) -> f64 {
+        if !self.plain {
+            return self.at(p.to_vec());
+        }
+        let px = &*self.pixels;
+        let (z, phi) = p.z_phi();
+        let j = px.edges.row(z).min(px.height - 1);
+        let i = ((phi * px.cols_per_rad) as usize).min(px.width - 1);
+        px.values[j * px.width + i]
     }
 }
 
@@ -637,39 +688,82 @@ fn cell_side(cells: &[[f64; 2]; 5]) -> f64 {
     side
 }
 
-impl Density<SphereRegion> for EnvMap {
-    fn bound(&self, region: &SphereRegion) -> f64 {
+impl EnvMap {
+    /// The maximum over the pixels a region touches, and the pixel's value
+    /// when it touches only one (then the region's exact average).
+    fn bound_in(&self, region: &SphereRegion) -> (f64, Option<f64>) {
         let px = &*self.pixels;
         match self.touched(region) {
-            (j0, j1, c0, c1) if c0 <= c1 => px.max_over(j0, j1, c0, c1),
-            (j0, j1, c0, c1) => px
-                .max_over(j0, j1, c0, px.width - 1)
-                .max(px.max_over(j0, j1, 0, c1)),
+            (j0, j1, c0, c1) if j0 == j1 && c0 == c1 => {
+                let v = px.values[j0 * px.width + c0];
+                (v, Some(v))
+            }
+            (j0, j1, c0, c1) if c0 <= c1 => (px.max_over(j0, j1, c0, c1), None),
+            (j0, j1, c0, c1) => (
+                px.max_over(j0, j1, c0, px.width - 1)
+                    .max(px.max_over(j0, j1, 0, c1)),
+                None,
+            ),
         }
     }
 
-    fn average(&self, region: &SphereRegion) -> f64 {
-        let (j0, j1, c0, c1) = self.touched(region);
-        if j0 == j1 && c0 == c1 {
-            // the tile lies in one pixel: its value is the exact average
-            return self.pixels.values[j0 * self.pixels.width + c0];
-        }
+    /// The midpoint rule over equal-area sub-cells about a pixel row across.
+    fn quadrature(&self, region: &SphereRegion) -> f64 {
         let side = cell_side(&region.cells);
         // pixel rows per cell side (a face side is about 1.02 rad)
         let rows = side * 1.02 / (PI / self.pixels.height as f64);
         // sub-cells at most about a pixel row across
-        let n = (rows.ceil() as usize).clamp(1, 8);
+        // `rows.ceil()` without a libm call (NaN gives 0 either way)
+        let whole = rows as usize;
+        let n = (whole + usize::from((whole as f64) < rows)).clamp(1, 8);
         let mut sum = 0.0;
+        if n == 1 {
+            for [cx, cy] in region.cells {
+                sum += self.at_face_point(FacePoint::new(region.face, cx, cy));
+            }
+            return sum / 5.0;
+        }
+        let mut offsets = [0.0f64; 8];
+        for (a, o) in offsets.iter_mut().enumerate().take(n) {
+            *o = side * ((a as f64 + 0.5) / n as f64 - 0.5);
+        }
+        let offsets = &offsets[..n];
         for [cx, cy] in region.cells {
-            for a in 0..n {
-                for b in 0..n {
-                    let x = cx + side * ((a as f64 + 0.5) / n as f64 - 0.5);
-                    let y = cy + side * ((b as f64 + 0.5) / n as f64 - 0.5);
-                    sum += self.at(FacePoint::new(region.face, x, y).to_vec());
+            for &da in offsets {
+                for &db in offsets {
+                    sum += self.at_face_point(FacePoint::new(region.face, cx + da, cy + db));
                 }
             }
         }
         sum / (5 * n * n) as f64
+    }
+}
+
+impl Density<SphereRegion> for EnvMap {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        self.bound_in(region).0
+    }
+
+    fn average(&self, region: &SphereRegion) -> f64 {
+        // a cap at least a pixel row across always touches two rows (or,
+        // clamped at a pole, every column): only smaller caps may lie in
+        // one pixel
+        if 2.0 * region.radius < PI / self.pixels.height as f64 || self.pixels.width == 1 {
+            let (j0, j1, c0, c1) = self.touched(region);
+            if j0 == j1 && c0 == c1 {
+                // the tile lies in one pixel: its value is the exact average
+                return self.pixels.values[j0 * self.pixels.width + c0];
+            }
+        }
+        self.quadrature(region)
+    }
+
+    fn bound_and_average(&self, region: &SphereRegion) -> (f64, Option<f64>) {
+        self.bound_in(region)
+    }
+
+    fn average_after_bound(&self, region: &SphereRegion) -> f64 {
+        self.quadrature(region)
     }
 
     fn value(&self, point: DVec3) -> f64 {

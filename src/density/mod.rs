@@ -41,6 +41,17 @@ pub trait Density<R: Region>: Sync {
     fn bound(&self, region: &R) -> f64;
     /// The density's average over the region (may be approximate).
     fn average(&self, region: &R) -> f64;
+    /// The bound over the region and, when the bound's own work gives it
+    /// (the region lies where the density is constant), the exact average.
+    /// The engine calls this once per visited tile.
+    fn bound_and_average(&self, region: &R) -> (f64, Option<f64>) {
+        (self.bound(region), None)
+    }
+    /// The average over a region for which [`Density::bound_and_average`]
+    /// gave none: may skip the checks that function already made.
+    fn average_after_bound(&self, region: &R) -> f64 {
+        self.average(region)
+    }
     /// The density at a point (used for pdfs).
     fn value(&self, point: R::Point) -> f64;
     /// The average over the whole domain (its integral over the domain's
@@ -88,6 +99,12 @@ impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
     }
     fn average(&self, region: &R) -> f64 {
         (**self).average(region)
+    }
+    fn bound_and_average(&self, region: &R) -> (f64, Option<f64>) {
+        (**self).bound_and_average(region)
+    }
+    fn average_after_bound(&self, region: &R) -> f64 {
+        (**self).average_after_bound(region)
     }
     fn value(&self, point: R::Point) -> f64 {
         (**self).value(point)

@@ -47,6 +47,11 @@ pub trait TileSystem: Sync {
     fn measure(&self) -> f64;
     /// The tile's threshold code.
     fn code(&self, tile: &Self::Tile) -> u64;
+    /// The code of child `i` of `tile`, without building the child (the
+    /// engine skips most children on their code alone).
+    fn child_code(&self, tile: &Self::Tile, i: usize) -> u64 {
+        self.code(&self.child(tile, i))
+    }
     /// The region a density bounds itself over.
     fn region(&self, tile: &Self::Tile) -> Self::Region;
     /// The tile of `level` whose code is `code`, when the system can find it

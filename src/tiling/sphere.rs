@@ -114,6 +114,8 @@ pub struct SphereTiling {
     roots_by_code: Vec<SphereTile>,
     /// `child_of_digit[rule][digit]`: which child carries a digit.
     child_of_digit: [[u8; 4]; 2],
+    /// `shape.centroid()`, cached for [`TileSystem::region`].
+    centroid: [f64; 2],
 }
 
 impl Default for SphereTiling {
@@ -138,6 +140,7 @@ impl SphereTiling {
             shape: Shape::p_pentomino(),
             roots_by_code: Vec::new(),
             child_of_digit: [[0; 4]; 2],
+            centroid: Shape::p_pentomino().centroid(),
         };
         let mut roots = tiling.roots();
         roots.sort_by_key(|t| t.code);
@@ -299,15 +302,25 @@ impl TileSystem for SphereTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        ROOT_COUNT as f64 * 4f64.powi(level as i32)
+        if level <= MAX_LEVEL {
+            // 240 * 4^26 < 2^60: exact in u64, and in f64 (a power of two times 15)
+            ((ROOT_COUNT as u64) << (2 * level)) as f64
+        } else {
+            ROOT_COUNT as f64 * 4f64.powi(level as i32)
+        }
     }
 
     fn code(&self, tile: &SphereTile) -> u64 {
         tile.code
     }
 
+    fn child_code(&self, tile: &SphereTile, i: usize) -> u64 {
+        let digit = self.lut.child_digit[tile.rule as usize][i] as u64;
+        tile.code + digit * ((ROOT_COUNT as u64) << (2 * tile.level as u32))
+    }
+
     fn region(&self, tile: &SphereTile) -> SphereRegion {
-        let centroid = self.shape.centroid();
+        let centroid = self.centroid;
         let cell = |i: usize| {
             let (cx, cy) = self.shape.cells()[i];
             let p = self.face_point(tile, [cx as f64 + 0.5, cy as f64 + 0.5]);
