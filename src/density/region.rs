@@ -195,14 +195,7 @@ impl Regions {
             let fail = |why: &str| Error::Density(spec.to_string(), why.to_string());
             let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
             if let Some(args) = spec.strip_prefix("cap:") {
-                let v: Vec<f64> = args
-                    .split(',')
-                    .map(|s| s.trim().parse::<f64>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|_| fail("expected numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))?;
-                let [lon, lat, radius, contrast] = v[..] else {
-                    return Err(fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"));
-                };
+                let [lon, lat, radius, contrast] = super::sphere::cap_numbers(spec, args)?;
                 // the same checks as a single cap
                 super::sphere::Cap::new(lon, lat, radius, contrast.max(f64::MIN_POSITIVE))
                     .map_err(|e| match e {

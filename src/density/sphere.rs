@@ -278,14 +278,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Density<SphereRegion> + Send>, Error>
         return Ok(Box::new(Uniform));
     }
     if let Some(args) = spec.strip_prefix("cap:") {
-        let numbers: Vec<f64> = args
-            .split(',')
-            .map(|s| s.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| fail("expected numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))?;
-        let [lon, lat, radius, contrast] = numbers[..] else {
-            return Err(fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"));
-        };
+        let [lon, lat, radius, contrast] = cap_numbers(spec, args)?;
         return Cap::new(lon, lat, radius, contrast)
             .map(|c| Box::new(c) as Box<dyn Density<SphereRegion> + Send>)
             .map_err(|e| match e {
@@ -296,4 +289,18 @@ pub fn parse(spec: &str) -> Result<Box<dyn Density<SphereRegion> + Send>, Error>
     Err(fail(
         "unknown density; expected 'uniform' or 'cap:LON,LAT,RADIUS_DEG,CONTRAST'",
     ))
+}
+
+/// The four numbers `LON,LAT,RADIUS_DEG,CONTRAST` of a `cap:` specification
+/// (`args` is what follows the prefix), shared by every parser of caps.
+pub(crate) fn cap_numbers(spec: &str, args: &str) -> Result<[f64; 4], Error> {
+    let fail = |why: &str| Error::Density(spec.to_string(), why.to_string());
+    let numbers: Vec<f64> = args
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| fail("expected numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))?;
+    numbers[..]
+        .try_into()
+        .map_err(|_| fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))
 }
