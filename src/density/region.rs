@@ -19,7 +19,7 @@
 
 use super::sphere::{angle_between, lonlat_to_vec};
 use super::Density;
-use crate::healpix::{lonlat_deg, FacePoint};
+use crate::healpix::lonlat_deg;
 use crate::tiling::sphere::SphereRegion;
 use crate::Error;
 use glam::DVec3;
@@ -261,20 +261,7 @@ impl Regions {
     /// The density's mean over the sphere by the equal-area quadrature of
     /// HEALPix cell centres at Nside 128.
     fn quadrature_mean(&self) -> f64 {
-        let nside = 128;
-        let mut sum = 0.0;
-        for face in 0..12u8 {
-            for j in 0..nside {
-                for i in 0..nside {
-                    let (x, y) = (
-                        (i as f64 + 0.5) / nside as f64,
-                        (j as f64 + 0.5) / nside as f64,
-                    );
-                    sum += self.at(FacePoint::new(face, x, y).to_vec());
-                }
-            }
-        }
-        sum / (12 * nside * nside) as f64
+        super::sphere::cell_centre_mean(128, |v| self.at(v))
     }
 
     fn at(&self, v: DVec3) -> f64 {

@@ -199,20 +199,7 @@ impl<F: Fn(DVec3) -> f64 + Sync> SphereFn<F> {
                 format!("Lipschitz constant {lipschitz} must be finite and >= 0"),
             ));
         }
-        let nside = 64;
-        let mut sum = 0.0;
-        for face in 0..12u8 {
-            for j in 0..nside {
-                for i in 0..nside {
-                    let (x, y) = (
-                        (i as f64 + 0.5) / nside as f64,
-                        (j as f64 + 0.5) / nside as f64,
-                    );
-                    sum += clean(f(FacePoint::new(face, x, y).to_vec()));
-                }
-            }
-        }
-        let mean = sum / (12 * nside * nside) as f64;
+        let mean = cell_centre_mean(64, |v| clean(f(v)));
         if mean.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !mean.is_finite() {
             return Err(Error::Density(
                 "closure".into(),
@@ -303,4 +290,20 @@ pub(crate) fn cap_numbers(spec: &str, args: &str) -> Result<[f64; 4], Error> {
     numbers[..]
         .try_into()
         .map_err(|_| fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))
+}
+
+/// The mean of `f` over the sphere by the equal-area quadrature of the
+/// HEALPix cell centres at `nside` (`12 nside^2` evaluations).
+pub(crate) fn cell_centre_mean(nside: u32, f: impl Fn(DVec3) -> f64) -> f64 {
+    let side = nside as f64;
+    let mut sum = 0.0;
+    for face in 0..12u8 {
+        for j in 0..nside {
+            for i in 0..nside {
+                let (x, y) = ((i as f64 + 0.5) / side, (j as f64 + 0.5) / side);
+                sum += f(FacePoint::new(face, x, y).to_vec());
+            }
+        }
+    }
+    sum / (12.0 * side * side)
 }
