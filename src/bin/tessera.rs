@@ -60,15 +60,9 @@ struct MetricsArgs {
     json: bool,
 }
 
+/// What every sampling command asks for: how many samples, and where to.
 #[derive(Args)]
-struct SphereArgs {
-    /// Importance: `uniform`, `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
-    /// density CONTRAST inside the cap, 1 outside) or
-    /// `polygon:LON LAT,LON LAT,...;CONTRAST` (GeoJSON-style lon/lat
-    /// polygon). Repeat it to combine regions: the largest contrast of the
-    /// regions containing a point wins, 1 elsewhere.
-    #[arg(long, default_value = "uniform")]
-    density: Vec<String>,
+struct RequestArgs {
     /// Number of samples (exact unless --expected).
     #[arg(short = 'n', long = "count")]
     count: usize,
@@ -78,6 +72,19 @@ struct SphereArgs {
     /// Output file, `-` for standard output.
     #[arg(short, long, default_value = "-")]
     output: PathBuf,
+}
+
+#[derive(Args)]
+struct SphereArgs {
+    /// Importance: `uniform`, `cap:LON,LAT,RADIUS_DEG,CONTRAST` (degrees;
+    /// density CONTRAST inside the cap, 1 outside) or
+    /// `polygon:LON LAT,LON LAT,...;CONTRAST` (GeoJSON-style lon/lat
+    /// polygon). Repeat it to combine regions: the largest contrast of the
+    /// regions containing a point wins, 1 elsewhere.
+    #[arg(long, default_value = "uniform")]
+    density: Vec<String>,
+    #[command(flatten)]
+    request: RequestArgs,
     /// xyz: `x y z` per line; lonlat: `lon lat` degrees; csv: header and a pdf
     /// column; geojson: a FeatureCollection of Points with a pdf property;
     /// bin: UTK binary (f64, 3 dimensions).
@@ -157,15 +164,8 @@ struct PlaneArgs {
     /// get the points).
     #[arg(long)]
     invert: bool,
-    /// Number of samples (exact unless --expected).
-    #[arg(short = 'n', long = "count")]
-    count: usize,
-    /// Skip the exactness pass: return the natural count near N.
-    #[arg(long)]
-    expected: bool,
-    /// Output file, `-` for standard output.
-    #[arg(short, long, default_value = "-")]
-    output: PathBuf,
+    #[command(flatten)]
+    request: RequestArgs,
     /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions).
     #[arg(long, default_value = "txt")]
     format: String,
@@ -295,15 +295,20 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
-    let mut out = create(&args.output)?;
-    let written = match engine::stream(&tiling, args.count) {
+    let mut out = create(&args.request.output)?;
+    let written = match engine::stream(&tiling, args.request.count) {
         // large uniform requests stream: memory stays O(depth)
-        Some(stream) if density.constant().is_some() && args.count > STREAM_ABOVE => {
+        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
             let points = stream.map(|s| s.position);
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
         _ => {
-            let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
+            let samples = engine::generate(
+                &tiling,
+                &*density,
+                args.request.count,
+                !args.request.expected,
+            )?;
             let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
             if args.report {
                 print_report(&points);
@@ -313,7 +318,7 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     };
     written
         .and_then(|()| out.flush())
-        .map_err(io_error(&args.output))
+        .map_err(io_error(&args.request.output))
 }
 
 fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<(), Error> {
@@ -350,16 +355,16 @@ fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<()
         None => map,
     };
     let tiling = SphereTiling::default();
-    let samples = engine::generate(&tiling, &map, args.count, !args.expected)?;
+    let samples = engine::generate(&tiling, &map, args.request.count, !args.request.expected)?;
     let points: Vec<glam::DVec3> = samples.iter().map(|s| map.to_world(s.position)).collect();
     if args.report {
         eprintln!("tessera: {name}: integral {} (value x sr)", map.integral());
         print_report(&points);
     }
-    let mut out = create(&args.output)?;
+    let mut out = create(&args.request.output)?;
     tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
         .and_then(|()| out.flush())
-        .map_err(io_error(&args.output))
+        .map_err(io_error(&args.request.output))
 }
 
 /// Separation, covering radius and mesh ratio of a point set (the O(N log N)
@@ -384,20 +389,25 @@ fn plane(args: PlaneArgs) -> Result<(), Error> {
         PlaneKind::Ghexomino => PlaneSystem::Ghexomino,
         PlaneKind::Ppentomino => PlaneSystem::Ppentomino,
     }));
-    let mut out = create(&args.output)?;
-    let written = match engine::stream(&tiling, args.count) {
+    let mut out = create(&args.request.output)?;
+    let written = match engine::stream(&tiling, args.request.count) {
         // large uniform requests stream: memory stays O(depth)
-        Some(stream) if density.constant().is_some() && args.count > STREAM_ABOVE => {
+        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
             tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format)
         }
         _ => {
-            let samples = engine::generate(&tiling, &*density, args.count, !args.expected)?;
+            let samples = engine::generate(
+                &tiling,
+                &*density,
+                args.request.count,
+                !args.request.expected,
+            )?;
             tessera::io::points::write_plane(&mut out, samples.iter().map(|s| s.position), format)
         }
     };
     written
         .and_then(|()| out.flush())
-        .map_err(io_error(&args.output))
+        .map_err(io_error(&args.request.output))
 }
 
 fn tiles(args: TilesArgs) -> Result<(), Error> {
