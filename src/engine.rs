@@ -19,7 +19,7 @@
 //! gathered in order, so the output does not depend on the thread count.
 
 use crate::density::{Density, Region};
-use crate::tiling::TileSystem;
+use crate::tiling::{Code, TileSystem};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -222,7 +222,7 @@ where
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
-        let sample = |code: u64, tile: &S::Tile| Sample {
+        let sample = |code: Code, tile: &S::Tile| Sample {
             position: system.sample(tile, fraction),
             rank: code as f64 / d,
         };

@@ -8,6 +8,16 @@ pub mod plane;
 pub mod polyomino;
 pub mod sphere;
 
+/// A tile's threshold code (see [`TileSystem`]). Wide enough for the
+/// deepest level of every system; compare it with densities through `as f64`.
+///
+/// # Example
+/// ```
+/// let code: tessera::tiling::Code = 7;
+/// assert_eq!(code as f64 + 0.5, 7.5);
+/// ```
+pub type Code = u64;
+
 /// A self-similar tiling with codes and offset tables, as the engine sees it.
 ///
 /// Codes: every tile at `level` has a code in `0..capacity(level)`; over the
@@ -46,10 +56,10 @@ pub trait TileSystem: Sync {
     /// Measure of the whole domain (4 pi for the sphere, area for the plane).
     fn measure(&self) -> f64;
     /// The tile's threshold code.
-    fn code(&self, tile: &Self::Tile) -> u64;
+    fn code(&self, tile: &Self::Tile) -> Code;
     /// The code of child `i` of `tile`, without building the child (the
     /// engine skips most children on their code alone).
-    fn child_code(&self, tile: &Self::Tile, i: usize) -> u64 {
+    fn child_code(&self, tile: &Self::Tile, i: usize) -> Code {
         self.code(&self.child(tile, i))
     }
     /// The region a density bounds itself over.
@@ -58,7 +68,7 @@ pub trait TileSystem: Sync {
     /// directly (base-A codes can: their digits spell the path from the
     /// root). Lets uniform requests stream in code order with no recursion,
     /// sort or buffer. `None` when unsupported or out of range.
-    fn tile_with_code(&self, level: u32, code: u64) -> Option<Self::Tile> {
+    fn tile_with_code(&self, level: u32, code: Code) -> Option<Self::Tile> {
         let _ = (level, code);
         None
     }
@@ -71,9 +81,9 @@ pub trait TileSystem: Sync {
         &self,
         level: u32,
         count: usize,
-        f: &(dyn Fn(u64, &Self::Tile) -> T + Sync),
+        f: &(dyn Fn(Code, &Self::Tile) -> T + Sync),
     ) -> Option<Vec<T>> {
-        (0..count as u64)
+        (0..count as Code)
             .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
             .collect()
     }

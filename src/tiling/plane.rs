@@ -15,7 +15,7 @@
 
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::tiling::polyomino::{Placement, Shape};
-use crate::tiling::TileSystem;
+use crate::tiling::{Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -42,7 +42,7 @@ pub struct PlaneTile {
     /// Structural index (automaton state).
     pub class: u32,
     /// Threshold code, `0..roots * A^level`.
-    pub code: u64,
+    pub code: Code,
 }
 
 /// A planar tile as a density sees it: its bounding box and cell centres in
@@ -392,7 +392,7 @@ impl TileSystem for PlaneTiling {
         1.0
     }
 
-    fn code(&self, tile: &PlaneTile) -> u64 {
+    fn code(&self, tile: &PlaneTile) -> Code {
         tile.code
     }
 
@@ -419,7 +419,7 @@ impl TileSystem for PlaneTiling {
         &self,
         level: u32,
         count: usize,
-        f: &(dyn Fn(u64, &PlaneTile) -> T + Sync),
+        f: &(dyn Fn(Code, &PlaneTile) -> T + Sync),
     ) -> Option<Vec<T>> {
         if level > self.max_level || count as f64 > self.capacity(level) {
             return None;
@@ -446,7 +446,7 @@ impl TileSystem for PlaneTiling {
         Some(out)
     }
 
-    fn tile_with_code(&self, level: u32, code: u64) -> Option<PlaneTile> {
+    fn tile_with_code(&self, level: u32, code: Code) -> Option<PlaneTile> {
         if level > self.max_level || code >= self.digit_weight[level as usize] {
             return None;
         }

@@ -15,7 +15,7 @@
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
 use crate::tiling::polyomino::{Placement, Shape};
-use crate::tiling::TileSystem;
+use crate::tiling::{Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -57,7 +57,7 @@ pub struct SphereTile {
     /// Structural index (tree position at shallow levels, class deeper).
     pub index: u32,
     /// Threshold code, `0..240 * 4^level`.
-    pub code: u64,
+    pub code: Code,
 }
 
 /// A tile as a density sees it: its face, cell-centre probes and a
@@ -310,11 +310,11 @@ impl TileSystem for SphereTiling {
         }
     }
 
-    fn code(&self, tile: &SphereTile) -> u64 {
+    fn code(&self, tile: &SphereTile) -> Code {
         tile.code
     }
 
-    fn child_code(&self, tile: &SphereTile, i: usize) -> u64 {
+    fn child_code(&self, tile: &SphereTile, i: usize) -> Code {
         let digit = self.lut.child_digit[tile.rule as usize][i] as u64;
         tile.code + digit * ((ROOT_COUNT as u64) << (2 * tile.level as u32))
     }
@@ -339,7 +339,7 @@ impl TileSystem for SphereTiling {
         &self,
         level: u32,
         count: usize,
-        f: &(dyn Fn(u64, &SphereTile) -> T + Sync),
+        f: &(dyn Fn(Code, &SphereTile) -> T + Sync),
     ) -> Option<Vec<T>> {
         if level > MAX_LEVEL || count as f64 > self.capacity(level) {
             return None;
@@ -367,7 +367,7 @@ impl TileSystem for SphereTiling {
         Some(out)
     }
 
-    fn tile_with_code(&self, level: u32, code: u64) -> Option<SphereTile> {
+    fn tile_with_code(&self, level: u32, code: Code) -> Option<SphereTile> {
         if level > MAX_LEVEL || code as f64 >= self.capacity(level) {
             return None;
         }
