@@ -56,11 +56,50 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    collect_parts(system, density, magnitude).concat()
+    collect_parts(system, density, magnitude, None).concat()
+}
+
+/// What [`collect`] returns from the tiles `overlaps` accepts, in rank
+/// order, without visiting the others: a window on a huge request costs
+/// what the window holds, not what the request holds. `overlaps` must be
+/// conservative (true for every tile that reaches into the window);
+/// children of a rejected tile are never asked.
+///
+/// # Example
+/// ```
+/// use tessera::{density::{sphere::Cap, Uniform}, engine, tiling::sphere::SphereTiling};
+/// let sphere = SphereTiling::default();
+/// let window = Cap::new(30.0, 10.0, 5.0, 1.0).unwrap();
+/// let near = engine::collect_within(&sphere, &Uniform, 1e6, &|r| window.reaches(r));
+/// let all = engine::collect(&sphere, &Uniform, 1e6);
+/// let inside = |s: &&engine::Sample<glam::DVec3>| window.contains(s.position);
+/// assert_eq!(near.iter().filter(inside).count(), all.iter().filter(inside).count());
+/// assert!(near.len() < all.len() / 100);
+/// ```
+pub fn collect_within<S, D>(
+    system: &S,
+    density: &D,
+    magnitude: f64,
+    overlaps: &(dyn Fn(&S::Region) -> bool + Sync),
+) -> Vec<Sample<S::Point>>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    by_rank(
+        collect_parts(system, density, magnitude, Some(overlaps)),
+        usize::MAX,
+    )
 }
 
 /// The accepted samples of each root's subtree, in root order.
-fn collect_parts<S, D>(system: &S, density: &D, magnitude: f64) -> Vec<Vec<Sample<S::Point>>>
+fn collect_parts<S, D>(
+    system: &S,
+    density: &D,
+    magnitude: f64,
+    window: Option<&(dyn Fn(&S::Region) -> bool + Sync)>,
+) -> Vec<Vec<Sample<S::Point>>>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
@@ -72,6 +111,7 @@ where
         magnitude,
         mean: density.mean(),
         constant: density.constant(),
+        window,
     };
     let roots = system.roots();
     // under a constant density every root receives about the same share
@@ -88,12 +128,14 @@ where
         .collect()
 }
 
-struct Walker<'a, S, D: ?Sized> {
+struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
     magnitude: f64,
     mean: f64,
     constant: Option<f64>,
+    /// Only tiles this accepts are visited (see [`collect_within`]).
+    window: Option<&'a (dyn Fn(&S::Region) -> bool + Sync)>,
 }
 
 impl<S, D> Walker<'_, S, D>
@@ -111,13 +153,17 @@ where
         if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
             return;
         }
-        let (bound, average, region) = match self.constant {
-            Some(c) => (c, Some(c), None),
-            None => {
-                let region = self.system.region(tile);
-                let (bound, average) = self.density.bound_and_average(&region);
-                (bound, average, Some(region))
+        let region =
+            (self.constant.is_none() || self.window.is_some()).then(|| self.system.region(tile));
+        if let (Some(window), Some(region)) = (self.window, &region) {
+            if !window(region) {
+                return;
             }
+        }
+        let (bound, average) = match (self.constant, &region) {
+            (Some(c), _) => (c, Some(c)),
+            (None, Some(region)) => self.density.bound_and_average(region),
+            (None, None) => unreachable!("a region exists whenever the density varies"),
         };
         let bound = self.magnitude * (bound / self.mean);
         if bound.is_nan() || bound <= 0.0 {
@@ -236,7 +282,7 @@ where
     } else {
         count as f64
     };
-    let mut parts = collect_parts(system, density, magnitude);
+    let mut parts = collect_parts(system, density, magnitude, None);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
         let found = total(&parts);
@@ -249,7 +295,7 @@ where
             (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
         };
         magnitude *= growth;
-        parts = collect_parts(system, density, magnitude);
+        parts = collect_parts(system, density, magnitude, None);
     }
     if exact && total(&parts) < count {
         return Err(Error::Request(format!(
@@ -376,8 +422,8 @@ pub struct Stream<'a, S: TileSystem> {
     level: u32,
     fraction: f64,
     d: f64,
-    next: u64,
-    end: u64,
+    next: Code,
+    end: Code,
 }
 
 /// A progressive stream of `count` uniform samples, if the system finds
@@ -399,7 +445,7 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
         fraction: d / system.capacity(level),
         d,
         next: 0,
-        end: count as u64,
+        end: count as Code,
     })
 }
 

@@ -4,7 +4,7 @@
 //! version; `luts/*.provenance.json` beside it records the command, seed,
 //! parameters and resulting metrics. `tessera lut build` regenerates both.
 
-use crate::tiling::polyomino::{Placement, Rule};
+use crate::tiling::polyomino::{Lattice, Placement, Rule};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};
@@ -335,7 +335,7 @@ pub struct PlaneLut {
     /// `child_digit[rule][child]`: the child's rank among its siblings.
     pub child_digit: Vec<Vec<u8>>,
     /// Side of the root patch in cells: the roots cover `[0, side)^2`.
-    pub side: i32,
+    pub side: Lattice,
     /// The root tiles.
     pub roots: Vec<Placement>,
     /// Rule of each root.
@@ -493,13 +493,13 @@ impl PlaneLut {
         {
             return bad("root tables have the wrong size");
         }
-        let mut covered: Vec<(i32, i32)> = self
+        let mut covered: Vec<(Lattice, Lattice)> = self
             .roots
             .iter()
             .flat_map(|p| p.cells(&self.shape).collect::<Vec<_>>())
             .collect();
         covered.sort_unstable();
-        let square: Vec<(i32, i32)> = (0..self.side)
+        let square: Vec<(Lattice, Lattice)> = (0..self.side)
             .flat_map(|x| (0..self.side).map(move |y| (x, y)))
             .collect();
         if covered != square {

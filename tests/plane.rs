@@ -9,8 +9,8 @@ use tessera::density::{Density, Uniform};
 use tessera::engine;
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
 use tessera::metrics::plane::{low_frequency_power, min_distance, periodogram, radial_average};
-use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
-use tessera::tiling::TileSystem;
+use tessera::tiling::plane::{PlaneRegion, PlaneTiling, MAX_LATTICE_SIDE};
+use tessera::tiling::{Code, TileSystem};
 
 fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
     [
@@ -279,18 +279,27 @@ fn the_deepest_level_keeps_codes_and_points_apart() {
         let level = tiling.max_level();
         let lut = tiling.lut();
         // exact: the f64 capacity rounds at these sizes
-        let cap = lut.roots.len() as u128 * (lut.arity() as u128).pow(level);
-        assert!(cap <= u64::MAX as u128);
-        // and the level is the deepest: one more overflows codes or lattice
-        let side = lut.side as i128 * (lut.rules[0].scale as i128).pow(level + 1);
-        assert!(cap * lut.arity() as u128 > u64::MAX as u128 || side > i32::MAX as i128 / 2);
-        let cap = cap as u64;
+        let cap = lut.roots.len() as Code * (lut.arity() as Code).pow(level);
+        // the level is the deepest: one more leaves f64 resolution
+        let scale = lut.rules[0].scale;
+        let side = lut.side * scale.pow(level);
+        assert!(side <= MAX_LATTICE_SIDE && side * scale > MAX_LATTICE_SIDE);
         let mut seen = Vec::new();
-        for code in [0u64, 1, 2, cap / 2, cap - 1] {
+        for code in [0, 1, 2, cap / 3, cap / 2, cap - 1] {
             let tile = tiling.tile_with_code(level, code).unwrap();
             assert_eq!(tile.code, code);
             let p = tiling.sample(&tile, 1.0);
             assert!(in_domain(&p));
+            // the point lies in one of its tile's lattice cells
+            let cell = (
+                (p.x * side as f64).floor() as i64,
+                (p.y * side as f64).floor() as i64,
+            );
+            let cells: Vec<_> = tile.placement.cells(&lut.shape).collect();
+            assert!(
+                cells.contains(&cell),
+                "code {code}: {cell:?} not in {cells:?}"
+            );
             seen.push(p);
         }
         for i in 0..seen.len() {
@@ -329,9 +338,9 @@ fn shipped_tables_are_small_and_round_trip() {
 fn codes_of_a_level_are_a_permutation() {
     for (_, tiling) in systems() {
         let level = 1;
-        let mut codes: Vec<u64> = tiling.tiles(level).iter().map(|t| t.code).collect();
+        let mut codes: Vec<Code> = tiling.tiles(level).iter().map(|t| t.code).collect();
         codes.sort_unstable();
-        assert!(codes.iter().enumerate().all(|(i, &c)| c == i as u64));
+        assert!(codes.iter().enumerate().all(|(i, &c)| c == i as Code));
     }
 }
 
@@ -339,7 +348,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     #[test]
-    fn tile_with_code_finds_the_tile_holding_the_code(code in 0u64..1_000_000) {
+    fn tile_with_code_finds_the_tile_holding_the_code(code in 0u128..1_000_000) {
         for (_, tiling) in systems() {
             let level = (0..=tiling.max_level()).find(|&l| tiling.capacity(l) > code as f64).unwrap();
             let tile = tiling.tile_with_code(level, code).unwrap();

@@ -26,7 +26,7 @@ use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
 use crate::optimize::exact_cover::tilings;
 use crate::optimize::ranking::farthest_point_ranks;
 use crate::tiling::plane::{PlaneTile, PlaneTiling};
-use crate::tiling::polyomino::{Placement, Rule, Shape};
+use crate::tiling::polyomino::{Lattice, Placement, Rule, Shape};
 use crate::tiling::TileSystem;
 use crate::Error;
 use rayon::prelude::*;
@@ -234,8 +234,8 @@ fn root_patch(
     system: PlaneSystem,
     shape: &Shape,
     rng: &mut SplitMix64,
-) -> Result<(i32, Vec<Placement>), Error> {
-    let rect = |w: i32, h: i32| -> Vec<(i32, i32)> {
+) -> Result<(Lattice, Vec<Placement>), Error> {
+    let rect = |w: Lattice, h: Lattice| -> Vec<(Lattice, Lattice)> {
         (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).collect()
     };
     let none = || Error::Request(format!("no root patch found for the {}", system.name()));
@@ -460,15 +460,15 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
     let mut owner: HashMap<(i64, i64), usize> = HashMap::new();
     for (i, t) in tiles.iter().enumerate() {
         for (x, y) in t.placement.cells(&lut.shape) {
-            owner.insert((x as i64, y as i64), i);
+            owner.insert((x, y), i);
         }
     }
     // (class, the neighbours' origins and orientations in the tile's frame)
-    type Neighbourhood = (u32, Vec<(i32, i32, usize)>);
+    type Neighbourhood = (u32, Vec<(Lattice, Lattice, usize)>);
     let mut counts: HashMap<Neighbourhood, usize> = HashMap::new();
     for (i, t) in tiles.iter().enumerate() {
         let inverse = t.placement.orientation.inverse();
-        let mut signature: Vec<(i32, i32, usize)> = Vec::new();
+        let mut signature: Vec<(Lattice, Lattice, usize)> = Vec::new();
         for (x, y) in t.placement.cells(&lut.shape) {
             for (dx, dy) in [
                 (1, 0),
@@ -480,10 +480,7 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
                 (-1, 1),
                 (-1, -1),
             ] {
-                let cell = (
-                    (x as i64 + dx).rem_euclid(size),
-                    (y as i64 + dy).rem_euclid(size),
-                );
+                let cell = ((x + dx).rem_euclid(size), (y + dy).rem_euclid(size));
                 let j = owner[&cell];
                 if j == i {
                     continue;
@@ -494,8 +491,8 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
                     o.origin.0 - t.placement.origin.0,
                     o.origin.1 - t.placement.origin.1,
                 );
-                rel.0 = (rel.0 as i64 + size / 2).rem_euclid(size) as i32 - (size / 2) as i32;
-                rel.1 = (rel.1 as i64 + size / 2).rem_euclid(size) as i32 - (size / 2) as i32;
+                rel.0 = (rel.0 + size / 2).rem_euclid(size) - size / 2;
+                rel.1 = (rel.1 + size / 2).rem_euclid(size) - size / 2;
                 let local = inverse.apply(rel);
                 let orient = o.orientation.then(inverse).index();
                 signature.push((local.0, local.1, orient));

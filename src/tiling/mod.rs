@@ -8,15 +8,17 @@ pub mod plane;
 pub mod polyomino;
 pub mod sphere;
 
-/// A tile's threshold code (see [`TileSystem`]). Wide enough for the
-/// deepest level of every system; compare it with densities through `as f64`.
+/// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
+/// every system's deepest level (the sphere's level 36 has `240 * 4^36`
+/// tiles, more than `u64` counts); compare codes with densities through
+/// `as f64`.
 ///
 /// # Example
 /// ```
 /// let code: tessera::tiling::Code = 7;
 /// assert_eq!(code as f64 + 0.5, 7.5);
 /// ```
-pub type Code = u64;
+pub type Code = u128;
 
 /// A self-similar tiling with codes and offset tables, as the engine sees it.
 ///

@@ -14,7 +14,7 @@
 //! the opposite side: every point lies in `[0, 1)^2`.
 
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
-use crate::tiling::polyomino::{Placement, Shape};
+use crate::tiling::polyomino::{Lattice, Placement, Shape};
 use crate::tiling::{Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
@@ -98,7 +98,7 @@ impl PlaneRegion {
 pub struct PlaneTiling {
     lut: Arc<PlaneLut>,
     arity: usize,
-    scale: i32,
+    scale: Lattice,
     bins: usize,
     max_level: u32,
     roots_by_code: Vec<PlaneTile>,
@@ -106,8 +106,8 @@ pub struct PlaneTiling {
     children: Vec<Placement>,
     /// `child_rule[rule * A + child]`.
     child_rule: Vec<u8>,
-    /// `child_digit[rule * A + child]`, as a `u64`.
-    child_digit: Vec<u64>,
+    /// `child_digit[rule * A + child]`, as a [`Code`].
+    child_digit: Vec<Code>,
     /// `child_of_digit[rule * A + digit]`.
     child_of_digit: Vec<u8>,
     /// Decoded offsets, `class * bins + bin`.
@@ -115,7 +115,7 @@ pub struct PlaneTiling {
     /// The density fraction each bin was optimised for, increasing.
     bin_fractions: Vec<f64>,
     /// Roots times `A^level`: the weight of a level's new digit.
-    digit_weight: Vec<u64>,
+    digit_weight: Vec<Code>,
     /// `1 / (side * scale^level)`: lattice to unit square.
     inv_size: Vec<f64>,
 }
@@ -132,27 +132,22 @@ impl PlaneTiling {
     pub fn new(lut: Arc<PlaneLut>) -> Self {
         let arity = lut.arity();
         let scale = lut.rules[0].scale;
-        let roots = lut.roots.len() as u64;
-        // deepest level whose codes fit u64 and lattice coordinates i32
-        let mut max_level = 0u32;
-        loop {
-            let next = max_level + 1;
-            let codes = (roots as u128) * (arity as u128).pow(next);
-            let size = lut.side as i128 * (scale as i128).pow(next) + 4 * scale as i128;
-            if codes > u64::MAX as u128 || size > i32::MAX as i128 {
-                break;
-            }
-            max_level = next;
-        }
+        let roots = lut.roots.len() as Code;
+        let max_level = deepest_level(lut.side, scale, roots, arity as Code);
         let digit_weight = (0..=max_level)
-            .map(|l| roots * (arity as u64).pow(l))
+            .map(|l| roots * (arity as Code).pow(l))
             .collect();
         let inv_size = (0..=max_level)
             .map(|l| 1.0 / (lut.side as f64 * (scale as f64).powi(l as i32)))
             .collect();
         let children = lut.rules.iter().flat_map(|r| r.children.clone()).collect();
         let child_rule = lut.child_rule.concat();
-        let child_digit: Vec<u64> = lut.child_digit.concat().iter().map(|&d| d as u64).collect();
+        let child_digit: Vec<Code> = lut
+            .child_digit
+            .concat()
+            .iter()
+            .map(|&d| d as Code)
+            .collect();
         let mut child_of_digit = vec![0u8; child_digit.len()];
         for (at, &d) in child_digit.iter().enumerate() {
             let rule = at / arity;
@@ -170,7 +165,7 @@ impl PlaneTiling {
                 level: 0,
                 rule: lut.root_rule[r],
                 class: lut.root_class[r],
-                code: lut.root_rank[r] as u64,
+                code: lut.root_rank[r] as Code,
             })
             .collect();
         roots_by_code.sort_by_key(|t| t.code);
@@ -293,7 +288,7 @@ impl PlaneTiling {
             level: 0,
             rule: lut.root_rule[r],
             class: lut.root_class[r],
-            code: lut.root_rank[r] as u64,
+            code: lut.root_rank[r] as Code,
         }
     }
 
@@ -426,7 +421,7 @@ impl TileSystem for PlaneTiling {
         }
         if level == 0 {
             let roots = self.roots_by_code[..count].iter().enumerate();
-            return Some(roots.map(|(code, t)| f(code as u64, t)).collect());
+            return Some(roots.map(|(code, t)| f(code as Code, t)).collect());
         }
         // codes `digit * m + c` share their parent with code `c` one level
         // up: find the parents once, then every digit block from them
@@ -440,7 +435,7 @@ impl TileSystem for PlaneTiling {
             }
             let block = parents[..(count - start).min(m)].par_iter().enumerate();
             out.par_extend(
-                block.map(|(c, p)| f((start + c) as u64, &self.child_with_digit(p, digit))),
+                block.map(|(c, p)| f((start + c) as Code, &self.child_with_digit(p, digit))),
             );
         }
         Some(out)
@@ -450,18 +445,49 @@ impl TileSystem for PlaneTiling {
         if level > self.max_level || code >= self.digit_weight[level as usize] {
             return None;
         }
-        let roots = self.roots_by_code.len() as u64;
+        let roots = self.roots_by_code.len() as Code;
         let mut tile = self.roots_by_code[(code % roots) as usize];
         let mut digits = code / roots;
         for _ in 0..level {
-            let digit = (digits % self.arity as u64) as usize;
+            let digit = (digits % self.arity as Code) as usize;
             tile = self.child_with_digit(&tile, digit);
-            digits /= self.arity as u64;
+            digits /= self.arity as Code;
         }
         Some(tile)
     }
 
     fn sample(&self, tile: &PlaneTile, fraction: f64) -> DVec2 {
         self.position(tile, self.bin(fraction))
+    }
+}
+
+/// Lattice cells per unit-square edge beyond which f64 positions lose
+/// resolution: `2^40` keeps a cell thousands of ulps wide.
+pub const MAX_LATTICE_SIDE: Lattice = 1 << 40;
+
+/// The deepest level of a `side`-cell root patch refined by `scale` per
+/// level whose codes (`roots * arity^level`) fit [`Code`] and whose lattice
+/// (`side * scale^level`, plus a child's reach) stays within
+/// [`MAX_LATTICE_SIDE`].
+///
+/// # Example
+/// ```
+/// use tessera::tiling::plane::deepest_level;
+/// // P-pentomino: 10 cells, doubling per level: 10 * 2^36 < 2^40 < 10 * 2^37
+/// assert_eq!(deepest_level(10, 2, 20, 4), 36);
+/// ```
+pub fn deepest_level(side: Lattice, scale: Lattice, roots: Code, arity: Code) -> u32 {
+    let mut level = 0u32;
+    loop {
+        let next = level + 1;
+        let codes = arity.checked_pow(next).and_then(|a| a.checked_mul(roots));
+        let size = scale
+            .checked_pow(next)
+            .and_then(|s| s.checked_mul(side))
+            .and_then(|s| s.checked_add(4 * scale));
+        match (codes, size) {
+            (Some(_), Some(size)) if size <= MAX_LATTICE_SIDE => level = next,
+            _ => return level,
+        }
     }
 }
