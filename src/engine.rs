@@ -59,6 +59,9 @@ where
     collect_parts(system, density, magnitude, None).concat()
 }
 
+/// A conservative test of whether a tile (its region) reaches into a window.
+pub type Window<'a, R> = dyn Fn(&R) -> bool + Sync + 'a;
+
 /// What [`collect`] returns from the tiles `overlaps` accepts, in rank
 /// order, without visiting the others: a window on a huge request costs
 /// what the window holds, not what the request holds. `overlaps` must be
@@ -80,7 +83,7 @@ pub fn collect_within<S, D>(
     system: &S,
     density: &D,
     magnitude: f64,
-    overlaps: &(dyn Fn(&S::Region) -> bool + Sync),
+    overlaps: &Window<'_, S::Region>,
 ) -> Vec<Sample<S::Point>>
 where
     S: TileSystem,
@@ -98,7 +101,7 @@ fn collect_parts<S, D>(
     system: &S,
     density: &D,
     magnitude: f64,
-    window: Option<&(dyn Fn(&S::Region) -> bool + Sync)>,
+    window: Option<&Window<'_, S::Region>>,
 ) -> Vec<Vec<Sample<S::Point>>>
 where
     S: TileSystem,
@@ -135,7 +138,7 @@ struct Walker<'a, S: TileSystem, D: ?Sized> {
     mean: f64,
     constant: Option<f64>,
     /// Only tiles this accepts are visited (see [`collect_within`]).
-    window: Option<&'a (dyn Fn(&S::Region) -> bool + Sync)>,
+    window: Option<&'a Window<'a, S::Region>>,
 }
 
 impl<S, D> Walker<'_, S, D>
