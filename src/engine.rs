@@ -19,7 +19,7 @@
 //! gathered in order, so the output does not depend on the thread count.
 
 use crate::density::{Density, Region};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::{code_value, Code, TileSystem};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -153,7 +153,7 @@ where
     fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
         let capacity = self.system.capacity(level);
-        if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
+        if capacity >= parent_bound && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
             return;
         }
         let region =
@@ -173,7 +173,7 @@ where
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
-            let code = self.system.code(tile) as f64;
+            let code = code_value(self.system.code(tile));
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
             }
@@ -215,7 +215,7 @@ where
         // skipped before they are built
         let child_rejects = self.system.capacity(level + 1) >= bound;
         for i in 0..self.system.child_count(tile) {
-            if child_rejects && self.system.child_code(tile, i) as f64 + 0.5 >= bound {
+            if child_rejects && code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
                 continue;
             }
             self.visit(&self.system.child(tile, i), bound, out);
@@ -273,7 +273,7 @@ where
         let (fraction, d) = (stream.fraction, stream.d);
         let sample = |code: Code, tile: &S::Tile| Sample {
             position: system.sample(tile, fraction),
-            rank: code as f64 / d,
+            rank: code_value(code) / d,
         };
         if let Some(samples) = system.map_code_order(stream.level, count, &sample) {
             return Ok(samples);
@@ -462,7 +462,7 @@ impl<S: TileSystem> Iterator for Stream<'_, S> {
         let tile = self.system.tile_with_code(self.level, self.next)?;
         let sample = Sample {
             position: self.system.sample(&tile, self.fraction),
-            rank: self.next as f64 / self.d,
+            rank: code_value(self.next) / self.d,
         };
         self.next += 1;
         Some(sample)

@@ -11,14 +11,39 @@ pub mod sphere;
 /// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
 /// every system's deepest level (the sphere's level 36 has `240 * 4^36`
 /// tiles, more than `u64` counts); compare codes with densities through
-/// `as f64`.
+/// [`code_value`].
 ///
 /// # Example
 /// ```
 /// let code: tessera::tiling::Code = 7;
-/// assert_eq!(code as f64 + 0.5, 7.5);
+/// assert_eq!(tessera::tiling::code_value(code) + 0.5, 7.5);
 /// ```
 pub type Code = u128;
+
+/// `code` as an f64. Codes below 2^64 (every sphere level to 28) take one
+/// instruction; a plain `as f64` of a u128 is a library call, which the
+/// engine would pay at every tile.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::code_value;
+/// assert_eq!(code_value(3), 3.0);
+/// assert_eq!(code_value(1 << 100), 2f64.powi(100));
+/// ```
+#[inline(always)]
+pub fn code_value(code: Code) -> f64 {
+    // the wide conversion sits out of line so that the compiler does not
+    // compute it speculatively next to the fast one
+    #[cold]
+    #[inline(never)]
+    fn wide(code: Code) -> f64 {
+        code as f64
+    }
+    match u64::try_from(code) {
+        Ok(small) => small as f64,
+        Err(_) => wide(code),
+    }
+}
 
 /// A self-similar tiling with codes and offset tables, as the engine sees it.
 ///

@@ -15,7 +15,7 @@
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
 use crate::tiling::polyomino::{Lattice, Placement, Shape};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::{code_value, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -303,12 +303,8 @@ impl TileSystem for SphereTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        if level <= MAX_LEVEL {
-            // 240 * 4^k: exact in Code, and in f64 (a power of two times 15)
-            ((ROOT_COUNT as Code) << (2 * level)) as f64
-        } else {
-            ROOT_COUNT as f64 * 4f64.powi(level as i32)
-        }
+        // 240 * 4^level: exact in f64 (15 times a power of two) at any level
+        ROOT_COUNT as f64 * 4f64.powi(level as i32)
     }
 
     fn code(&self, tile: &SphereTile) -> Code {
@@ -369,7 +365,7 @@ impl TileSystem for SphereTiling {
     }
 
     fn tile_with_code(&self, level: u32, code: Code) -> Option<SphereTile> {
-        if level > MAX_LEVEL || code as f64 >= self.capacity(level) {
+        if level > MAX_LEVEL || code_value(code) >= self.capacity(level) {
             return None;
         }
         let mut tile = *self
