@@ -271,11 +271,7 @@ where
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
-        let sample = |code: Code, tile: &S::Tile| Sample {
-            position: system.sample(tile, fraction),
-            rank: code_value(code) / d,
-        };
-        if let Some(samples) = system.map_code_order(stream.level, count, &sample) {
+        if let Some(samples) = system.code_order_samples(stream.level, count, fraction, d) {
             return Ok(samples);
         }
     }

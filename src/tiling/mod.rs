@@ -8,6 +8,8 @@ pub mod plane;
 pub mod polyomino;
 pub mod sphere;
 
+use crate::engine::Sample;
+
 /// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
 /// every system's deepest level (the sphere's level 36 has `240 * 4^36`
 /// tiles, more than `u64` counts); compare codes with densities through
@@ -113,6 +115,33 @@ pub trait TileSystem: Sync {
         (0..count as Code)
             .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
             .collect()
+    }
+    /// The samples of the tiles of `level` with codes `0..count` (what a
+    /// constant density of `d` samples per domain accepts: density
+    /// `fraction` of the level's capacity), ranked `code / d`, in code
+    /// order; `None` as for [`TileSystem::map_code_order`]. The default
+    /// samples every tile that method yields; systems override it to place
+    /// points without building whole tiles.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let s = sphere.code_order_samples(1, 500, 500.0 / 960.0, 500.0).unwrap();
+    /// assert_eq!(s.len(), 500);
+    /// assert_eq!(s[10].rank, 10.0 / 500.0);
+    /// ```
+    fn code_order_samples(
+        &self,
+        level: u32,
+        count: usize,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Vec<Sample<Self::Point>>> {
+        self.map_code_order(level, count, &|code, tile| Sample {
+            position: self.sample(tile, fraction),
+            rank: code_value(code) / d,
+        })
     }
     /// The sample position of an accepted tile, when the local density is
     /// `fraction * capacity(level)` (fraction in `(0, 1]`): reference point

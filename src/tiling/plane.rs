@@ -13,9 +13,10 @@
 //! periodically), so a point pushed across the square's border re-enters on
 //! the opposite side: every point lies in `[0, 1)^2`.
 
+use crate::engine::Sample;
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
-use crate::tiling::polyomino::{Lattice, Placement, Shape};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
+use crate::tiling::{code_value, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -102,8 +103,10 @@ pub struct PlaneTiling {
     bins: usize,
     max_level: u32,
     roots_by_code: Vec<PlaneTile>,
-    /// `children[rule * A + child]`.
-    children: Vec<Placement>,
+    /// `steps[(rule * A + child) * 8 + parent orientation]`: the child's
+    /// placement in a parent at the origin so oriented, on the refined
+    /// lattice.
+    steps: Vec<Placement>,
     /// `child_rule[rule * A + child]`.
     child_rule: Vec<u8>,
     /// `child_digit[rule * A + child]`, as a [`Code`].
@@ -140,7 +143,14 @@ impl PlaneTiling {
         let inv_size = (0..=max_level)
             .map(|l| 1.0 / (lut.side as f64 * (scale as f64).powi(l as i32)))
             .collect();
-        let children = lut.rules.iter().flat_map(|r| r.children.clone()).collect();
+        let steps = lut
+            .rules
+            .iter()
+            .flat_map(|r| &r.children)
+            .flat_map(|child| {
+                Orientation::ALL.map(|o| Placement::new((0, 0), o).child(child, scale))
+            })
+            .collect();
         let child_rule = lut.child_rule.concat();
         let child_digit: Vec<Code> = lut
             .child_digit
@@ -175,7 +185,7 @@ impl PlaneTiling {
             bins: lut.bins as usize,
             max_level,
             roots_by_code,
-            children,
+            steps,
             child_rule,
             child_digit,
             child_of_digit,
@@ -246,12 +256,20 @@ impl PlaneTiling {
     #[inline]
     fn subdivide(&self, tile: &PlaneTile, child: usize) -> PlaneTile {
         let at = tile.rule as usize * self.arity + child;
+        let code = tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize];
+        self.child_coded(tile, child, code)
+    }
+
+    /// Child `child` of `tile`, whose code the caller already knows.
+    #[inline(always)]
+    fn child_coded(&self, tile: &PlaneTile, child: usize, code: Code) -> PlaneTile {
+        let at = tile.rule as usize * self.arity + child;
         PlaneTile {
-            placement: tile.placement.child(&self.children[at], self.scale),
+            placement: self.child_placement(&tile.placement, at),
             level: tile.level + 1,
             rule: self.child_rule[at],
             class: self.lut.transitions[tile.class as usize * self.arity + child],
-            code: tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize],
+            code,
         }
     }
 
@@ -329,13 +347,31 @@ impl PlaneTiling {
 
     #[inline]
     fn position(&self, tile: &PlaneTile, bin: usize) -> DVec2 {
-        let [ox, oy] = self.offsets[tile.class as usize * self.bins + bin];
-        let m = tile.placement.orientation.matrix();
-        let (x0, y0) = tile.placement.origin;
-        let x = x0 as f64 + m[0][0] as f64 * ox + m[0][1] as f64 * oy;
-        let y = y0 as f64 + m[1][0] as f64 * ox + m[1][1] as f64 * oy;
         let s = self.inv_size[tile.level as usize];
+        self.place(&tile.placement, tile.class, bin, s)
+    }
+
+    /// The point of a tile so placed, of structural index `class`, in
+    /// importance bin `bin`, on a lattice of `1 / s` cells per unit.
+    #[inline(always)]
+    fn place(&self, placement: &Placement, class: u32, bin: usize, s: f64) -> DVec2 {
+        let [x, y] = placement.to_lattice(self.offsets[class as usize * self.bins + bin]);
         DVec2::new(wrap(x * s), wrap(y * s))
+    }
+
+    /// The placement of child `at` (`rule * A + child`) of a tile so placed:
+    /// [`Placement::child`] from a table of the child's step for each of
+    /// the parent's 8 orientations.
+    #[inline(always)]
+    fn child_placement(&self, parent: &Placement, at: usize) -> Placement {
+        let step = &self.steps[at * 8 + parent.orientation.index()];
+        Placement {
+            origin: (
+                self.scale * parent.origin.0 + step.origin.0,
+                self.scale * parent.origin.1 + step.origin.1,
+            ),
+            orientation: step.orientation,
+        }
     }
 }
 
@@ -434,9 +470,55 @@ impl TileSystem for PlaneTiling {
                 break;
             }
             let block = parents[..(count - start).min(m)].par_iter().enumerate();
-            out.par_extend(
-                block.map(|(c, p)| f((start + c) as Code, &self.child_with_digit(p, digit))),
-            );
+            out.par_extend(block.with_min_len(1024).map(|(c, p)| {
+                // the child carrying `digit` has code `start + c`
+                let code = (start + c) as Code;
+                let child = self.child_of_digit[p.rule as usize * self.arity + digit];
+                f(code, &self.child_coded(p, child as usize, code))
+            }));
+        }
+        Some(out)
+    }
+
+    /// Places each point straight from its parent (placement, class, bin
+    /// found once), without building the child tile or its code.
+    fn code_order_samples(
+        &self,
+        level: u32,
+        count: usize,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Vec<Sample<DVec2>>> {
+        if level == 0 || level > self.max_level || count as f64 > self.capacity(level) {
+            return self.map_code_order(level, count, &|code, tile| Sample {
+                position: self.sample(tile, fraction),
+                rank: code_value(code) / d,
+            });
+        }
+        let (bin, s, a) = (
+            self.bin(fraction),
+            self.inv_size[level as usize],
+            self.arity,
+        );
+        let m = self.digit_weight[level as usize - 1] as usize;
+        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
+        let mut out = Vec::with_capacity(count);
+        for digit in 0..a {
+            let start = digit * m;
+            if start >= count {
+                break;
+            }
+            let block = parents[..(count - start).min(m)].par_iter().enumerate();
+            out.par_extend(block.with_min_len(1024).map(|(c, p)| {
+                let child = self.child_of_digit[p.rule as usize * a + digit] as usize;
+                let at = p.rule as usize * a + child;
+                let placement = self.child_placement(&p.placement, at);
+                let class = self.lut.transitions[p.class as usize * a + child];
+                Sample {
+                    position: self.place(&placement, class, bin, s),
+                    rank: (start + c) as f64 / d,
+                }
+            }));
         }
         Some(out)
     }

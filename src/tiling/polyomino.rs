@@ -142,11 +142,12 @@ impl Orientation {
     /// use tessera::tiling::polyomino::Orientation;
     /// assert_eq!(Orientation::new(1, false).apply_f64([0.5, 0.0]), [0.0, 0.5]);
     /// ```
+    #[inline]
     pub fn apply_f64(self, v: [f64; 2]) -> [f64; 2] {
-        let m = self.matrix();
+        let m = &MATRICES_F64[self.0 as usize];
         [
-            m[0][0] as f64 * v[0] + m[0][1] as f64 * v[1],
-            m[1][0] as f64 * v[0] + m[1][1] as f64 * v[1],
+            m[0][0] * v[0] + m[0][1] * v[1],
+            m[1][0] * v[0] + m[1][1] * v[1],
         ]
     }
 
@@ -188,6 +189,21 @@ const MATRICES: [[[Lattice; 2]; 2]; 8] = {
             _ => (0, -1),
         };
         out[k] = [[c * mirror, -s], [s * mirror, c]];
+        k += 1;
+    }
+    out
+};
+
+/// [`MATRICES`] in f64, for placing points without conversions.
+const MATRICES_F64: [[[f64; 2]; 2]; 8] = {
+    let mut out = [[[0.0; 2]; 2]; 8];
+    let mut k = 0;
+    while k < 8 {
+        let m = MATRICES[k];
+        out[k] = [
+            [m[0][0] as f64, m[0][1] as f64],
+            [m[1][0] as f64, m[1][1] as f64],
+        ];
         k += 1;
     }
     out
