@@ -40,7 +40,7 @@ impl Checked {
             // there when it is near the tile
             let on_edge = [fp.x, fp.y].iter().any(|&c| c.min(1.0 - c) < 1e-12);
             let reach = FACE_LIPSCHITZ * 4.0 / nside;
-            let near = angle_between(p, self.inner.region(tile).center) <= reach;
+            let near = angle_between(p, self.inner.region(tile).center()) <= reach;
             return on_edge && near;
         }
         let placement = tile.placement;

@@ -78,7 +78,7 @@ fn bounding_caps_contain_their_tiles() {
                     for b in 0..=4 {
                         let local = [cx as f64 + a as f64 / 4.0, cy as f64 + b as f64 / 4.0];
                         let p = tiling.face_point(t, local).to_vec();
-                        let d = angle_between(p, region.center);
+                        let d = angle_between(p, region.center());
                         worst = worst.max(d / region.radius);
                         assert!(d <= region.radius, "tile point outside its cap");
                     }

@@ -129,7 +129,7 @@ impl Cap {
     /// assert!(reached >= 4 && reached < 20);
     /// ```
     pub fn reaches(&self, region: &SphereRegion) -> bool {
-        angle_between(self.center, region.center) - region.radius <= self.radius
+        angle_between(self.center, region.center()) - region.radius <= self.radius
     }
 
     /// The fraction of a sample set's expected mass that lies in the cap.
@@ -147,7 +147,7 @@ impl Cap {
 
 impl Density<SphereRegion> for Cap {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        let distance = angle_between(self.center, region.center);
+        let distance = angle_between(self.center, region.center());
         if distance + region.radius <= self.radius {
             self.contrast
         } else if distance - region.radius > self.radius {
@@ -157,7 +157,7 @@ impl Density<SphereRegion> for Cap {
         }
     }
     fn average(&self, region: &SphereRegion) -> f64 {
-        let distance = angle_between(self.center, region.center);
+        let distance = angle_between(self.center, region.center());
         if distance + region.radius <= self.radius {
             return self.contrast;
         }
@@ -251,7 +251,7 @@ fn clean(v: f64) -> f64 {
 
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        clean((self.f)(region.center)) + self.lipschitz * region.radius
+        clean((self.f)(region.center())) + self.lipschitz * region.radius
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let probes = region.probes();

@@ -73,8 +73,8 @@ pub struct SphereTile {
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct SphereRegion {
-    /// The tile's centroid on the sphere.
-    pub center: DVec3,
+    /// The tile's centroid, in face coordinates (see [`SphereRegion::center`]).
+    pub centroid: FacePoint,
     /// Angular radius (rad) of a cap around `center` containing the tile.
     pub radius: f64,
     /// Base face.
@@ -84,6 +84,20 @@ pub struct SphereRegion {
 }
 
 impl SphereRegion {
+    /// The tile's centroid on the sphere (computed on demand: densities
+    /// that work in face or pixel coordinates never pay its trigonometry).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let region = sphere.region(&sphere.roots()[0]);
+    /// assert!((region.center().length() - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn center(&self) -> DVec3 {
+        self.centroid.to_vec()
+    }
+
     /// The five cell centres as unit vectors (an equal-weight quadrature).
     ///
     /// # Example
@@ -303,8 +317,10 @@ impl TileSystem for SphereTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        // 240 * 4^level: exact in f64 (15 times a power of two) at any level
-        ROOT_COUNT as f64 * 4f64.powi(level as i32)
+        // 240 * 4^level, exact (15 times a power of two): 4^level built
+        // from its exponent bits rather than by a `powi` call per tile
+        let four_to_level = f64::from_bits((1023 + 2 * level.min(500) as u64) << 52);
+        ROOT_COUNT as f64 * four_to_level
     }
 
     fn code(&self, tile: &SphereTile) -> Code {
@@ -325,7 +341,7 @@ impl TileSystem for SphereTiling {
         };
         let nside = Self::nside(tile.level as u32) as f64;
         SphereRegion {
-            center: self.face_point(tile, centroid).to_vec(),
+            centroid: self.face_point(tile, centroid),
             radius: FACE_LIPSCHITZ * PENTOMINO_RADIUS / nside,
             face: tile.face,
             cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
