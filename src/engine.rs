@@ -69,7 +69,8 @@ where
     let walker = Walker {
         system,
         density,
-        magnitude,
+        // thresholds compare codes, so the request goes in code units
+        magnitude: magnitude * system.codes_per_sample(),
         mean: density.mean(),
         constant: density.constant(),
     };
@@ -124,6 +125,9 @@ where
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
+            if !self.system.carries_sample(tile) {
+                return;
+            }
             let code = self.system.code(tile) as f64;
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average

@@ -15,7 +15,7 @@
 
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::tiling::polyomino::{Placement, Shape};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::{mirror_unit, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -340,23 +340,8 @@ impl PlaneTiling {
         let x = x0 as f64 + m[0][0] as f64 * ox + m[0][1] as f64 * oy;
         let y = y0 as f64 + m[1][0] as f64 * ox + m[1][1] as f64 * oy;
         let s = self.inv_size[tile.level as usize];
-        DVec2::new(wrap(x * s), wrap(y * s))
+        DVec2::new(mirror_unit(x * s), mirror_unit(y * s))
     }
-}
-
-/// `v` mirrored into `[0, 1)` at the square's edges.
-#[inline]
-fn wrap(v: f64) -> f64 {
-    let w = if v < 0.0 {
-        -v
-    } else if v >= 1.0 {
-        2.0 - v
-    } else {
-        return v;
-    };
-    // offsets move points less than a root tile, so one mirror suffices;
-    // the largest f64 below 1 keeps the half-open square
-    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }
 
 impl TileSystem for PlaneTiling {
