@@ -147,7 +147,9 @@ where
             if d.is_nan() || code + 0.5 >= d {
                 return;
             }
-            let position = self.system.sample(tile, (d / capacity).min(1.0));
+            let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
+                return; // the tiling reaches past the domain there
+            };
             // an offset may carry a sample off the support of a partly lit
             // tile (a map lit in one pixel): then the tile's children place
             // it, the one sharing its code (and lit) keeping it

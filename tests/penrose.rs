@@ -125,7 +125,7 @@ fn every_vertex_in_the_square_is_one_point_tile() {
     let key = |p: DVec2| ((p.x * 1e8).round() as i64, (p.y * 1e8).round() as i64);
     let inside = |p: DVec2| (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y);
     let mut points = HashSet::new();
-    for p in tiles.iter().filter(|p| p.kind.is_point()) {
+    for p in tiles.iter().filter(|p| p.kind.is_point() && inside(p.v[0])) {
         assert!(points.insert(key(p.v[0])), "vertex {} owned twice", p.v[0]);
     }
     let vertices: HashSet<_> = tiles
@@ -146,7 +146,7 @@ fn codes_are_distinct_zeckendorf_numbers_of_uniform_density() {
     let points: Vec<PenroseTile> = t
         .tiles(level)
         .into_iter()
-        .filter(|p| p.kind.is_point())
+        .filter(|p| p.kind.is_point() && in_domain(&p.v[0]))
         .collect();
     let cap = t.capacity(level);
     let codes: HashSet<_> = points.iter().map(|p| p.code).collect();

@@ -102,6 +102,13 @@ pub trait TileSystem: Sync {
     fn codes_per_sample(&self) -> f64 {
         1.0
     }
+    /// The sample of an accepted tile as the recursion places it: `None`
+    /// when it falls outside the domain (a tiling that extends beyond its
+    /// domain keeps only the samples inside, so spacing holds at the
+    /// border). Defaults to [`TileSystem::sample`].
+    fn sample_in_domain(&self, tile: &Self::Tile, fraction: f64) -> Option<Self::Point> {
+        Some(self.sample(tile, fraction))
+    }
     /// The sample position of an accepted tile, when the local density is
     /// `fraction * capacity(level)` (fraction in `(0, 1]`): reference point
     /// plus the table offset in the tile's basis.

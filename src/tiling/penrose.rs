@@ -27,9 +27,10 @@
 //! of `log_phi^2` of the density, in bins.
 //!
 //! The root is one golden triangle holding the unit square with a margin;
-//! tiles that miss the square are never produced, and an offset that
-//! carries a point over the square's edge is mirrored back, so every point
-//! lies in `[0, 1)^2`.
+//! tiles whose samples cannot reach the square are never produced, and the
+//! samples that land outside it are dropped, as a tiling of the whole plane
+//! cut to the square would: every point lies in `[0, 1)^2` and spacing holds
+//! up to the border.
 
 use crate::lut::{penrose_lut, PenroseLut};
 use crate::tiling::plane::{PlaneRegion, MAX_CELLS};
@@ -369,13 +370,9 @@ impl PenroseTiling {
         (out, kept)
     }
 
-    /// Points: the vertex lies in `[0, 1)^2`; triangles: their box, grown
-    /// by the reach of their points' offsets, meets it.
+    /// Whether any sample of the tile or its descendants may land in the
+    /// square: its box, grown by the reach of the offsets, meets it.
     fn reaches_square(&self, tile: &PenroseTile) -> bool {
-        if tile.kind.is_point() {
-            let p = tile.v[0];
-            return (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y);
-        }
         let (lo, hi) = self.bounds(tile);
         lo.x < 1.0 && lo.y < 1.0 && hi.x >= 0.0 && hi.y >= 0.0
     }
@@ -493,6 +490,11 @@ impl PenroseTiling {
     }
 }
 
+/// Whether `p` lies in `[0, 1)^2`.
+fn in_square(p: DVec2) -> bool {
+    (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)
+}
+
 impl TileSystem for PenroseTiling {
     type Tile = PenroseTile;
     type Point = DVec2;
@@ -565,6 +567,14 @@ impl TileSystem for PenroseTiling {
         PenroseTiling::codes_per_area()
     }
 
+    fn sample_in_domain(&self, tile: &PenroseTile, fraction: f64) -> Option<DVec2> {
+        let p = self.place(tile, self.offset(tile, self.bin(fraction)));
+        in_square(p).then_some(p)
+    }
+
+    /// The sample mirrored into the square when its offset carries it out
+    /// (the engine keeps only samples inside, see
+    /// [`TileSystem::sample_in_domain`]).
     fn sample(&self, tile: &PenroseTile, fraction: f64) -> DVec2 {
         let p = self.place(tile, self.offset(tile, self.bin(fraction)));
         DVec2::new(mirror_unit(p.x), mirror_unit(p.y))
