@@ -327,3 +327,92 @@ fn output_is_progressive_and_deterministic() {
     };
     assert_eq!(run(1), run(2));
 }
+
+#[test]
+fn the_sampler_builder_drives_the_penrose_tiling() {
+    let sampler = tessera::Sampler::new(tiling()).density(Ramp).count(300);
+    let samples = sampler.generate().unwrap();
+    assert_eq!(samples.len(), 300);
+    let pdfs = sampler.pdfs(&samples);
+    assert!(samples
+        .iter()
+        .zip(&pdfs)
+        .all(|(s, &p)| (p - 2.0 * s.position.x).abs() < 1e-12));
+}
+
+fn tessera(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn cli_samples_and_draws_the_penrose_tiling() {
+    let dir = std::env::temp_dir().join(format!("tessera-penrose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("ramp.txt");
+    let run = tessera(&[
+        "plane",
+        "--system",
+        "penrose",
+        "--density",
+        "ramp",
+        "-n",
+        "777",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let points: Vec<DVec2> = text
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            DVec2::new(v[0], v[1])
+        })
+        .collect();
+    assert_eq!(points.len(), 777);
+    assert!(points.iter().all(in_domain));
+    let svg = dir.join("tiles.svg");
+    let run = tessera(&[
+        "tiles",
+        "--system",
+        "penrose",
+        "--level",
+        "5",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let drawing = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        drawing.contains("<polygon") && drawing.contains("<text") && drawing.contains("<circle")
+    );
+    let refused = tessera(&[
+        "tiles", "--system", "penrose", "--level", "15", "--svg", "x.svg",
+    ]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("level 15"));
+    let refused = tessera(&[
+        "lut",
+        "build",
+        "--system",
+        "penrose",
+        "--bins",
+        "1",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("2 bins"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
