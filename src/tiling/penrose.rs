@@ -52,6 +52,27 @@ pub const GEOMETRY_LEVELS: u32 = 45;
 /// Structural indices: values of six Fibonacci digits.
 pub const CLASSES: usize = 21;
 
+/// The production rules: each kind's children (kind, new digits) in rule
+/// order, indexed by `Kind as usize`.
+const RULES: [&[(Kind, (u8, u8))]; 6] = [
+    &[(Kind::B, (0, 0))],
+    &[(Kind::A, (0, 0))],
+    &[(Kind::F, (0, 0)), (Kind::C, (1, 0)), (Kind::A, (1, 0))],
+    &[(Kind::E, (0, 0)), (Kind::D, (1, 0))],
+    &[
+        (Kind::F, (0, 0)),
+        (Kind::C, (1, 0)),
+        (Kind::E, (0, 1)),
+        (Kind::A, (1, 0)),
+    ],
+    &[
+        (Kind::E, (0, 0)),
+        (Kind::D, (1, 0)),
+        (Kind::F, (0, 1)),
+        (Kind::A, (0, 1)),
+    ],
+];
+
 /// Tile types of the extended production rules.
 ///
 /// # Example
@@ -121,6 +142,9 @@ pub struct PenroseTile {
     /// the leg that gets the new vertex). Point tiles: the point, then its
     /// frame's two axes, one edge of the tile's level long.
     pub v: [DVec2; 3],
+    /// Whether every sample the tile and its descendants may place lies
+    /// inside the square (then no descendant needs the border test).
+    pub inside: bool,
 }
 
 impl PenroseTile {
@@ -258,6 +282,7 @@ impl PenroseTiling {
             level: 0,
             digits: 0,
             code: 0,
+            inside: false,
             v: [
                 DVec2::new(x, y0 + height),
                 DVec2::new(x - half_base, y0),
@@ -289,70 +314,69 @@ impl PenroseTiling {
     /// assert_eq!([kids[0].kind, kids[1].kind, kids[2].kind], [Kind::F, Kind::C, Kind::A]);
     /// ```
     pub fn all_children(&self, tile: &PenroseTile) -> ([PenroseTile; 4], usize) {
-        let level = tile.level as usize + 1;
-        let [a, b, c] = tile.v;
+        let n = RULES[tile.kind as usize].len();
         let mut out = [*tile; 4];
-        let mut n = 0;
-        let mut push = |kind: Kind, (hi, lo): (u8, u8), v: [DVec2; 3]| {
-            let mut code = tile.code;
-            if hi == 1 {
-                code += self.fib[2 * level + 1];
-            }
-            if lo == 1 {
-                code += self.fib[2 * level];
-            }
-            out[n] = PenroseTile {
-                kind,
-                level: level as u8,
-                digits: (hi << 5) | (lo << 4) | (tile.digits >> 2),
-                code,
-                v,
-            };
-            n += 1;
-        };
+        for (i, child) in out.iter_mut().enumerate().take(n) {
+            *child = self.nth_child(tile, i);
+        }
+        (out, n)
+    }
+
+    /// Child `i` (rule order) of `tile`, inside the square or not.
+    #[inline]
+    fn nth_child(&self, tile: &PenroseTile, i: usize) -> PenroseTile {
+        let [a, b, c] = tile.v;
+        let (kind, (hi, lo)) = RULES[tile.kind as usize][i];
+        // the new vertex of a golden triangle (on its leg), and of a gnomon
+        // (q on its leg, r on its base)
+        let p = || a + (b - a) / PHI;
+        let q = || b + (a - b) / PHI;
+        let r = || b + (c - b) / PHI;
         // a point's frame at birth: the parent's leg direction, scaled to
         // the child edge, turned the way the parent winds
         let frame = |p: DVec2, wind: f64| {
             let e1 = (b - a) / PHI;
             [p, e1, e1.perp() * wind]
         };
-        match tile.kind {
-            Kind::A | Kind::B => {
-                let kind = if tile.kind == Kind::A {
-                    Kind::B
-                } else {
-                    Kind::A
-                };
-                push(kind, (0, 0), [a, b / PHI, c / PHI]);
-            }
-            Kind::C | Kind::D => {
-                let p = a + (b - a) / PHI;
-                if tile.kind == Kind::C {
-                    push(Kind::F, (0, 0), [p, c, a]);
-                    push(Kind::C, (1, 0), [c, p, b]);
-                    push(Kind::A, (1, 0), frame(p, 1.0));
-                } else {
-                    push(Kind::E, (0, 0), [p, c, a]);
-                    push(Kind::D, (1, 0), [c, p, b]);
-                }
-            }
-            Kind::E | Kind::F => {
-                let q = b + (a - b) / PHI;
-                let r = b + (c - b) / PHI;
-                if tile.kind == Kind::E {
-                    push(Kind::F, (0, 0), [q, r, b]);
-                    push(Kind::C, (1, 0), [r, q, a]);
-                    push(Kind::E, (0, 1), [r, c, a]);
-                    push(Kind::A, (1, 0), frame(q, -1.0));
-                } else {
-                    push(Kind::E, (0, 0), [q, r, b]);
-                    push(Kind::D, (1, 0), [r, q, a]);
-                    push(Kind::F, (0, 1), [r, c, a]);
-                    push(Kind::A, (0, 1), frame(r, 1.0));
-                }
-            }
+        let v = match (tile.kind, i) {
+            (Kind::A | Kind::B, _) => [a, b / PHI, c / PHI],
+            (Kind::C | Kind::D, 0) => [p(), c, a],
+            (Kind::C | Kind::D, 1) => [c, p(), b],
+            (Kind::C, _) => frame(p(), 1.0),
+            (_, 0) => [q(), r(), b],
+            (_, 1) => [r(), q(), a],
+            (_, 2) => [r(), c, a],
+            (Kind::E, _) => frame(q(), -1.0),
+            (_, _) => frame(r(), 1.0),
+        };
+        let level = tile.level + 1;
+        let mut child = PenroseTile {
+            kind,
+            level,
+            digits: (hi << 5) | (lo << 4) | (tile.digits >> 2),
+            code: tile.code + self.digit_code(level, (hi, lo)),
+            v,
+            inside: tile.inside,
+        };
+        if !child.inside {
+            let (lo, hi) = self.bounds(&child);
+            child.inside = lo.cmpge(DVec2::ZERO).all() && hi.cmplt(DVec2::ONE).all();
         }
-        (out, n)
+        child
+    }
+
+    /// The value of a level's two new digits.
+    #[inline]
+    fn digit_code(&self, level: u8, (hi, lo): (u8, u8)) -> Code {
+        let level = level as usize;
+        let mut code = 0;
+        if hi == 1 {
+            code += self.fib[2 * level + 1];
+        }
+        if lo == 1 {
+            code += self.fib[2 * level];
+        }
+        code
     }
 
     /// The children of `tile` that reach the unit square (what the engine
@@ -505,11 +529,28 @@ impl TileSystem for PenroseTiling {
     }
 
     fn child_count(&self, tile: &PenroseTile) -> usize {
-        self.children(tile).1
+        if tile.inside {
+            RULES[tile.kind as usize].len()
+        } else {
+            self.children(tile).1
+        }
     }
 
     fn child(&self, tile: &PenroseTile, i: usize) -> PenroseTile {
-        self.children(tile).0[i]
+        if tile.inside {
+            self.nth_child(tile, i)
+        } else {
+            self.children(tile).0[i]
+        }
+    }
+
+    fn child_code(&self, tile: &PenroseTile, i: usize) -> Code {
+        if tile.inside {
+            let digits = RULES[tile.kind as usize][i].1;
+            tile.code + self.digit_code(tile.level + 1, digits)
+        } else {
+            self.children(tile).0[i].code
+        }
     }
 
     fn level(&self, tile: &PenroseTile) -> u32 {
