@@ -111,7 +111,8 @@ where
     let walker = Walker {
         system,
         density,
-        magnitude,
+        // thresholds compare codes, so the request goes in code units
+        magnitude: magnitude * system.codes_per_sample(),
         mean: density.mean(),
         constant: density.constant(),
         window,
@@ -173,6 +174,9 @@ where
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
+            if !self.system.carries_sample(tile) {
+                return;
+            }
             let code = code_value(self.system.code(tile));
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
@@ -192,7 +196,9 @@ where
             if d.is_nan() || code + 0.5 >= d {
                 return;
             }
-            let position = self.system.sample(tile, (d / capacity).min(1.0));
+            let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
+                return; // the tiling reaches past the domain there
+            };
             // an offset may carry a sample off the support of a partly lit
             // tile (a map lit in one pixel): then the tile's children place
             // it, the one sharing its code (and lit) keeping it

@@ -24,6 +24,7 @@
 use crate::baselines::SplitMix64;
 use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
 use crate::optimize::exact_cover::tilings;
+use crate::optimize::lloyd::{cell_moments, torus_d2, wrap_half, TorusGrid};
 use crate::optimize::ranking::farthest_point_ranks;
 use crate::tiling::plane::{PlaneTile, PlaneTiling};
 use crate::tiling::polyomino::{Lattice, Placement, Rule, Shape};
@@ -544,30 +545,7 @@ fn relax(
     for _ in 0..options.iterations {
         let sites = sites_of(&tiles, &offsets, p);
         let grid = TorusGrid::new(&sites, p);
-        // nearest site of every quadrature point, rows in parallel; sums in
-        // row order so the result does not depend on the thread count
-        let rows: Vec<Vec<u32>> = (0..n)
-            .into_par_iter()
-            .map(|j| {
-                (0..n)
-                    .map(|i| {
-                        let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
-                        grid.nearest(qp, None).0 as u32
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut sum = vec![[0.0f64; 2]; sites.len()];
-        let mut count = vec![0usize; sites.len()];
-        for (j, row) in rows.iter().enumerate() {
-            for (i, &s) in row.iter().enumerate() {
-                let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
-                let s = s as usize;
-                sum[s][0] += wrap_half(qp[0] - sites[s][0], p);
-                sum[s][1] += wrap_half(qp[1] - sites[s][1], p);
-                count[s] += 1;
-            }
-        }
+        let (sum, count) = cell_moments(&grid, n, h, [0.0, 0.0]);
         // each class moves by the mean of its sites' moves, in tile frames
         let mut class_sum = vec![[0.0f64; 2]; offsets.len()];
         let mut class_n = vec![0usize; offsets.len()];
@@ -669,102 +647,4 @@ fn separate(tiles: &[PlaneTile], offsets: &mut [[f64; 2]], p: f64, steps: usize)
         }
     }
     offsets.copy_from_slice(&best);
-}
-
-/// `v` reduced into `[-p/2, p/2)`.
-fn wrap_half(v: f64, p: f64) -> f64 {
-    v - p * (v / p + 0.5).floor()
-}
-
-fn torus_d2(a: [f64; 2], b: [f64; 2], p: f64) -> f64 {
-    let dx = wrap_half(a[0] - b[0], p);
-    let dy = wrap_half(a[1] - b[1], p);
-    dx * dx + dy * dy
-}
-
-/// Nearest-point queries on the torus `[0, p)^2` by bucketing into a grid
-/// of about one point per bucket.
-struct TorusGrid<'a> {
-    points: &'a [[f64; 2]],
-    period: f64,
-    n: usize,
-    start: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl<'a> TorusGrid<'a> {
-    fn new(points: &'a [[f64; 2]], period: f64) -> Self {
-        let n = ((points.len() as f64).sqrt() as usize).max(1);
-        let bucket = |q: [f64; 2]| -> usize {
-            let f = |v: f64| (((v.rem_euclid(period)) / period * n as f64) as usize).min(n - 1);
-            f(q[1]) * n + f(q[0])
-        };
-        let mut start = vec![0u32; n * n + 1];
-        for &q in points {
-            start[bucket(q) + 1] += 1;
-        }
-        for k in 0..n * n {
-            start[k + 1] += start[k];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; points.len()];
-        for (i, &q) in points.iter().enumerate() {
-            let b = bucket(q);
-            items[fill[b] as usize] = i as u32;
-            fill[b] += 1;
-        }
-        TorusGrid {
-            points,
-            period,
-            n,
-            start,
-            items,
-        }
-    }
-
-    /// Index and squared distance of the nearest point other than `exclude`.
-    fn nearest(&self, q: [f64; 2], exclude: Option<usize>) -> (usize, f64) {
-        let n = self.n as i64;
-        let cell = self.period / self.n as f64;
-        let at = |v: f64| ((v.rem_euclid(self.period) / cell) as i64).min(n - 1);
-        let (cx, cy) = (at(q[0]), at(q[1]));
-        let mut best = (usize::MAX, f64::INFINITY);
-        let visit = |bx: i64, by: i64, best: &mut (usize, f64)| {
-            let b = (by.rem_euclid(n) * n + bx.rem_euclid(n)) as usize;
-            for &i in &self.items[self.start[b] as usize..self.start[b + 1] as usize] {
-                let i = i as usize;
-                if Some(i) == exclude {
-                    continue;
-                }
-                let d = torus_d2(q, self.points[i], self.period);
-                if d < best.1 || (d == best.1 && i < best.0) {
-                    *best = (i, d);
-                }
-            }
-        };
-        let mut r = 0i64;
-        loop {
-            if 2 * r + 1 >= n {
-                // the ring wraps onto itself: scan everything
-                for by in 0..n {
-                    for bx in 0..n {
-                        visit(bx, by, &mut best);
-                    }
-                }
-                return best;
-            }
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx.abs() == r || dy.abs() == r {
-                        visit(cx + dx, cy + dy, &mut best);
-                    }
-                }
-            }
-            // anything outside rings 0..=r is at least r cells away
-            if best.1 <= (r as f64 * cell).powi(2) {
-                return best;
-            }
-            r += 1;
-        }
-    }
 }

@@ -4,6 +4,7 @@
 //! indices and offset tables; it knows nothing of densities or file formats.
 //! [`crate::engine`] drives any [`TileSystem`].
 
+pub mod penrose;
 pub mod plane;
 pub mod polyomino;
 pub mod sphere;
@@ -143,8 +144,45 @@ pub trait TileSystem: Sync {
             rank: code_value(code) / d,
         })
     }
+    /// Whether a terminal tile carries a sample. Penrose triangles only
+    /// subdivide: its point tiles carry the samples.
+    fn carries_sample(&self, tile: &Self::Tile) -> bool {
+        let _ = tile;
+        true
+    }
+    /// Code units per expected sample: over the domain, about
+    /// `c / codes_per_sample()` sampling tiles of a level have codes below
+    /// `c`. 1 when codes are a permutation of `0..capacity` (systems that
+    /// find tiles from codes must keep it 1); the engine scales requests by
+    /// it.
+    fn codes_per_sample(&self) -> f64 {
+        1.0
+    }
+    /// The sample of an accepted tile as the recursion places it: `None`
+    /// when it falls outside the domain (a tiling that extends beyond its
+    /// domain keeps only the samples inside, so spacing holds at the
+    /// border). Defaults to [`TileSystem::sample`].
+    fn sample_in_domain(&self, tile: &Self::Tile, fraction: f64) -> Option<Self::Point> {
+        Some(self.sample(tile, fraction))
+    }
     /// The sample position of an accepted tile, when the local density is
     /// `fraction * capacity(level)` (fraction in `(0, 1]`): reference point
     /// plus the table offset in the tile's basis.
     fn sample(&self, tile: &Self::Tile, fraction: f64) -> Self::Point;
+}
+
+/// `v` mirrored into `[0, 1)` at the unit square's edges (points an offset
+/// carries just outside re-enter).
+#[inline]
+pub(crate) fn mirror_unit(v: f64) -> f64 {
+    let w = if v < 0.0 {
+        -v
+    } else if v >= 1.0 {
+        2.0 - v
+    } else {
+        return v;
+    };
+    // offsets move points less than a root tile, so one mirror suffices;
+    // the largest f64 below 1 keeps the half-open square
+    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }

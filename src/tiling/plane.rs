@@ -16,7 +16,7 @@
 use crate::engine::Sample;
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
-use crate::tiling::{code_value, Code, TileSystem};
+use crate::tiling::{code_value, mirror_unit, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -356,7 +356,7 @@ impl PlaneTiling {
     #[inline(always)]
     fn place(&self, placement: &Placement, class: u32, bin: usize, s: f64) -> DVec2 {
         let [x, y] = placement.to_lattice(self.offsets[class as usize * self.bins + bin]);
-        DVec2::new(wrap(x * s), wrap(y * s))
+        DVec2::new(mirror_unit(x * s), mirror_unit(y * s))
     }
 
     /// The placement of child `at` (`rule * A + child`) of a tile so placed:
@@ -373,21 +373,6 @@ impl PlaneTiling {
             orientation: step.orientation,
         }
     }
-}
-
-/// `v` mirrored into `[0, 1)` at the square's edges.
-#[inline]
-fn wrap(v: f64) -> f64 {
-    let w = if v < 0.0 {
-        -v
-    } else if v >= 1.0 {
-        2.0 - v
-    } else {
-        return v;
-    };
-    // offsets move points less than a root tile, so one mirror suffices;
-    // the largest f64 below 1 keeps the half-open square
-    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }
 
 impl TileSystem for PlaneTiling {
