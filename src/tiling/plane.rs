@@ -465,8 +465,12 @@ impl TileSystem for PlaneTiling {
         Some(out)
     }
 
-    /// Places each point straight from its parent (placement, class, bin
-    /// found once), without building the child tile or its code.
+    /// Places each point straight from its grandparent: the parents are
+    /// found on the fly and no tile is built for them or the points. Code
+    /// `d * m1 + e * m2 + k` (digits `d`, `e`; `m1`, `m2` the parent and
+    /// grandparent levels' tile counts) is child `d` of child `e` of
+    /// grandparent `k`, so each `(d, e)` is a run of `k` in the output,
+    /// written in order.
     fn code_order_samples(
         &self,
         level: u32,
@@ -474,7 +478,7 @@ impl TileSystem for PlaneTiling {
         fraction: f64,
         d: f64,
     ) -> Option<Vec<Sample<DVec2>>> {
-        if level == 0 || level > self.max_level || count as f64 > self.capacity(level) {
+        if level < 2 || level > self.max_level || count as f64 > self.capacity(level) {
             return self.map_code_order(level, count, &|code, tile| Sample {
                 position: self.sample(tile, fraction),
                 rank: code_value(code) / d,
@@ -485,26 +489,44 @@ impl TileSystem for PlaneTiling {
             self.inv_size[level as usize],
             self.arity,
         );
-        let m = self.digit_weight[level as usize - 1] as usize;
-        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
-        let mut out = Vec::with_capacity(count);
-        for digit in 0..a {
-            let start = digit * m;
-            if start >= count {
-                break;
-            }
-            let block = parents[..(count - start).min(m)].par_iter().enumerate();
-            out.par_extend(block.with_min_len(1024).map(|(c, p)| {
-                let child = self.child_of_digit[p.rule as usize * a + digit] as usize;
-                let at = p.rule as usize * a + child;
-                let placement = self.child_placement(&p.placement, at);
-                let class = self.lut.transitions[p.class as usize * a + child];
-                Sample {
-                    position: self.place(&placement, class, bin, s),
-                    rank: (start + c) as f64 / d,
-                }
-            }));
+        let m1 = self.digit_weight[level as usize - 1] as usize;
+        let m2 = self.digit_weight[level as usize - 2] as usize;
+        let grandparents = self.map_code_order(level - 2, count.min(m2), &|_, t| {
+            (t.placement, t.rule, t.class)
+        })?;
+        let unset = Sample {
+            position: DVec2::ZERO,
+            rank: 0.0,
+        };
+        let mut out = vec![unset; count];
+        // runs[e]: the output runs of the parents of digit `e`, one per `d`
+        let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
+        for (q, run) in out.chunks_mut(m2).enumerate() {
+            runs[q % a].push((q / a, run));
         }
+        runs.into_par_iter().enumerate().for_each(|(e, mut runs)| {
+            let longest = runs.iter().map(|(_, run)| run.len()).max().unwrap_or(0);
+            for (k, (placement, rule, class)) in grandparents[..longest].iter().enumerate() {
+                // the parent: child of digit `e`
+                let child = self.child_of_digit[*rule as usize * a + e] as usize;
+                let at = *rule as usize * a + child;
+                let parent = self.child_placement(placement, at);
+                let (rule, class) = (
+                    self.child_rule[at] as usize,
+                    self.lut.transitions[*class as usize * a + child] as usize,
+                );
+                for (digit, run) in runs.iter_mut() {
+                    let Some(slot) = run.get_mut(k) else { continue };
+                    let child = self.child_of_digit[rule * a + *digit] as usize;
+                    let placement = self.child_placement(&parent, rule * a + child);
+                    let class = self.lut.transitions[class * a + child];
+                    *slot = Sample {
+                        position: self.place(&placement, class, bin, s),
+                        rank: (*digit * m1 + e * m2 + k) as f64 / d,
+                    };
+                }
+            }
+        });
         Some(out)
     }
 
