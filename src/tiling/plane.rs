@@ -121,6 +121,33 @@ pub struct PlaneTiling {
     digit_weight: Vec<Code>,
     /// `1 / (side * scale^level)`: lattice to unit square.
     inv_size: Vec<f64>,
+    /// The shape's cells and bounding box in each of the 8 orientations.
+    frames: [Frame; 8],
+}
+
+/// A rep-tile's cells (lower-left corners) and the corners of its bounding
+/// box, relative to a placement's origin, in one orientation.
+#[derive(Clone, Debug, Default)]
+struct Frame {
+    cells: Vec<(Lattice, Lattice)>,
+    lo: (Lattice, Lattice),
+    hi: (Lattice, Lattice),
+}
+
+impl Frame {
+    fn new(shape: &Shape, orientation: Orientation) -> Self {
+        let cells: Vec<_> = Placement::new((0, 0), orientation).cells(shape).collect();
+        let corner = |pick: fn(Lattice, Lattice) -> Lattice, far: Lattice| {
+            let x = cells.iter().map(|c| c.0).reduce(pick).unwrap_or(0);
+            let y = cells.iter().map(|c| c.1).reduce(pick).unwrap_or(0);
+            (x + far, y + far)
+        };
+        Frame {
+            lo: corner(Lattice::min, 0),
+            hi: corner(Lattice::max, 1),
+            cells,
+        }
+    }
 }
 
 impl PlaneTiling {
@@ -193,6 +220,7 @@ impl PlaneTiling {
             bin_fractions,
             digit_weight,
             inv_size,
+            frames: Orientation::ALL.map(|o| Frame::new(&lut.shape, o)),
             lut,
         }
     }
@@ -401,7 +429,10 @@ impl TileSystem for PlaneTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        self.lut.roots.len() as f64 * (self.arity as f64).powi(level as i32)
+        match self.digit_weight.get(level as usize) {
+            Some(&tiles) => code_value(tiles),
+            None => self.lut.roots.len() as f64 * (self.arity as f64).powi(level as i32),
+        }
     }
 
     fn measure(&self) -> f64 {
@@ -414,21 +445,20 @@ impl TileSystem for PlaneTiling {
 
     fn region(&self, tile: &PlaneTile) -> PlaneRegion {
         let s = self.inv_size[tile.level as usize];
-        let mut region = PlaneRegion {
-            lo: DVec2::INFINITY,
-            hi: DVec2::NEG_INFINITY,
-            cell: s,
-            cells: [DVec2::ZERO; MAX_CELLS],
-            count: 0,
-        };
-        for (k, (x, y)) in tile.placement.cells(&self.lut.shape).enumerate() {
-            let corner = DVec2::new(x as f64, y as f64) * s;
-            region.lo = region.lo.min(corner);
-            region.hi = region.hi.max(corner + s);
-            region.cells[k] = corner + 0.5 * s;
-            region.count += 1;
+        let (x0, y0) = tile.placement.origin;
+        let at = |(dx, dy): (Lattice, Lattice)| DVec2::new((x0 + dx) as f64, (y0 + dy) as f64) * s;
+        let frame = &self.frames[tile.placement.orientation.index()];
+        let mut cells = [DVec2::ZERO; MAX_CELLS];
+        for (cell, &offset) in cells.iter_mut().zip(&frame.cells) {
+            *cell = at(offset) + 0.5 * s;
         }
-        region
+        PlaneRegion {
+            lo: at(frame.lo),
+            hi: at(frame.hi),
+            cell: s,
+            cells,
+            count: frame.cells.len() as u8,
+        }
     }
 
     fn map_code_order<T: Send>(
