@@ -184,7 +184,8 @@ struct TilesArgs {
     /// Tile system to draw.
     #[arg(long, value_enum)]
     system: System,
-    /// Subdivision level (0..=5).
+    /// Subdivision level (sphere 0..=5, Penrose 0..=14, polyominoes up to
+    /// 200000 tiles).
     #[arg(long, default_value_t = 0)]
     level: u32,
     /// SVG file to write.
