@@ -169,3 +169,23 @@ fn cli_samples_a_rectangle_and_refuses_bad_ones() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("domain") && err.contains("finite"), "{err}");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+    #[test]
+    fn any_rectangle_gets_exactly_n_points_inside(
+        x0 in -1e3f64..1e3,
+        y0 in -1e3f64..1e3,
+        w in 1e-3f64..1e3,
+        h in 1e-3f64..1e3,
+        n in 0usize..400,
+        ramp in proptest::bool::ANY,
+    ) {
+        let rect = Rectangle::new(x0, y0, x0 + w, y0 + h).unwrap();
+        each_system(|name, run| {
+            let s = run(&rect, n, ramp);
+            assert_eq!(s.len(), n, "{name}");
+            assert!(s.iter().all(|s| rect.contains(s.position)), "{name} {rect:?}");
+        });
+    }
+}
