@@ -11,7 +11,11 @@
 //!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
-//! `magnitude` is the expected sample count over the whole domain, `mean`
+//! Tiles that carry no sample (Penrose's triangles) stop at the terminal
+//! test, and a sample the system places outside its domain is dropped
+//! ([`TileSystem::sample_in_domain`]).
+//! `magnitude` is the expected sample count over the whole domain (in code
+//! units: times [`TileSystem::codes_per_sample`]), `mean`
 //! the density's mean over it (dividing first keeps densities anywhere in
 //! 1e-300..1e300, subnormals included, from overflowing). Ranks order the output progressively: the samples with rank
 //! below `s` are those an `s`-times smaller request accepts, so every prefix

@@ -416,3 +416,24 @@ fn cli_samples_and_draws_the_penrose_tiling() {
     assert!(String::from_utf8_lossy(&refused.stderr).contains("2 bins"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_single_bright_pixel_and_a_dark_half_are_respected() {
+    let t = tiling();
+    let (w, h) = (256, 256);
+    let mut pixels = vec![1e-6; w * h];
+    pixels[200 * w + 37] = 1e6; // about 94 % of the mass
+    let raster = Raster::new(w, h, pixels, false).unwrap();
+    let points = positions(&t, &raster, 2000);
+    let inside = points
+        .iter()
+        .filter(|p| (p.x * w as f64) as usize == 37 && (p.y * h as f64) as usize == 200)
+        .count();
+    assert!(inside > 1700, "{inside} of 2000 in the bright pixel");
+    // left half black, right half white: inverted, the samples go left
+    let raster = Raster::new(2, 1, vec![0.0, 1.0], true).unwrap();
+    let points = positions(&t, &raster, 500);
+    assert_eq!(points.len(), 500);
+    let right = points.iter().filter(|p| p.x >= 0.5).count();
+    assert!(right <= 5, "{right} points on the white side");
+}

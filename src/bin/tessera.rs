@@ -173,6 +173,10 @@ struct PlaneArgs {
     /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions).
     #[arg(long, default_value = "txt")]
     format: String,
+    /// Sample the rectangle `x0,y0,x1,y1` instead of the unit square (the
+    /// density's unit square stretched over it).
+    #[arg(long)]
+    domain: Option<String>,
 }
 
 #[derive(Args)]
@@ -180,7 +184,8 @@ struct TilesArgs {
     /// Tile system to draw.
     #[arg(long, value_enum)]
     system: System,
-    /// Subdivision level (0..=5).
+    /// Subdivision level (sphere 0..=5, Penrose 0..=14, polyominoes up to
+    /// 200000 tiles).
     #[arg(long, default_value_t = 0)]
     level: u32,
     /// SVG file to write.
@@ -406,20 +411,30 @@ where
 {
     let format: tessera::io::points::PlaneFormat = args.format.parse()?;
     let density = tessera::density::plane::parse(&args.density, args.invert)?;
+    let rect = args
+        .domain
+        .as_deref()
+        .map(tessera::density::rectangle::Rectangle::parse)
+        .transpose()?;
+    let (count, exact) = (args.request.count, !args.request.expected);
     let mut out = create(&args.request.output)?;
-    let written = match engine::stream(tiling, args.request.count) {
+    let written = match engine::stream(tiling, count) {
         // large uniform requests stream: memory stays O(depth)
-        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
+        Some(stream) if density.constant().is_some() && rect.is_none() && count > STREAM_ABOVE => {
             tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format)
         }
         _ => {
-            let samples = engine::generate(
-                tiling,
-                &*density,
-                args.request.count,
-                !args.request.expected,
-            )?;
-            tessera::io::points::write_plane(&mut out, samples.iter().map(|s| s.position), format)
+            let points: Vec<glam::DVec2> = match rect {
+                Some(rect) => engine::generate(tiling, &rect.restrict(&*density), count, exact)?
+                    .iter()
+                    .map(|s| rect.to_world(s.position))
+                    .collect(),
+                None => engine::generate(tiling, &*density, count, exact)?
+                    .iter()
+                    .map(|s| s.position)
+                    .collect(),
+            };
+            tessera::io::points::write_plane(&mut out, points, format)
         }
     };
     written

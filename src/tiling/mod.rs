@@ -51,10 +51,12 @@ pub fn code_value(code: Code) -> f64 {
 /// A self-similar tiling with codes and offset tables, as the engine sees it.
 ///
 /// Codes: every tile at `level` has a code in `0..capacity(level)`; over the
-/// whole domain the codes of one level are a permutation of that range, and a
-/// child's code extends its parent's with a new most significant digit. A
-/// terminal tile is accepted when `code < d`, `d` being the requested density
-/// in samples per domain, so thresholds keep well-spread subsets.
+/// whole domain the codes of one level are a permutation of that range (or,
+/// for Penrose's Fibonacci codes, spread evenly over it: see
+/// [`TileSystem::codes_per_sample`]), and a child's code extends its
+/// parent's with a new most significant digit. A terminal tile is accepted
+/// when `code < d`, `d` being the requested density in samples per domain
+/// (times `codes_per_sample`), so thresholds keep well-spread subsets.
 ///
 /// # Example
 /// ```

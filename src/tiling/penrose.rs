@@ -438,7 +438,9 @@ impl PenroseTiling {
     }
 
     /// The importance index of a density `fraction` of a level's capacity:
-    /// the fractional part of `log_phi^2 fraction`, in bins, rounded up so
+    /// the fractional part of `log_phi^2 fraction`, in bins (as
+    /// `capacity(k) = F(2k + 2)` is about `phi^(2k + 2) / sqrt 5`, this is
+    /// the reference's `log_phi^2 (sqrt 5 d) mod 1` for `d` codes), rounded up so
     /// a fraction is served by the bin optimised for the first density at
     /// or above it (whose accepted points include its own).
     ///
