@@ -1,6 +1,7 @@
 //! Baseline point sets to compare samplers against: the spherical Fibonacci
-//! lattice, independent uniform points on the sphere and in the square, and
-//! the jittered grid, with a small self-contained RNG ([`SplitMix64`]) so
+//! lattice, independent uniform points on the sphere and in the square, the
+//! jittered grid and jittered HEALPix, Owen-scrambled Sobol ([`sobol`])
+//! warped by inverse CDFs ([`cdf`], [`envmap`]), with a small self-contained RNG ([`SplitMix64`]) so
 //! that results are reproducible from a seed without extra dependencies.
 //!
 //! ```
@@ -10,7 +11,9 @@
 //! assert_eq!(jittered_grid_2d(3, 0).len(), 9);
 //! ```
 
+pub mod cdf;
 pub mod envmap;
+pub mod sobol;
 
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
@@ -142,12 +145,25 @@ pub fn uniform_random_sphere(n: usize, seed: u64) -> Vec<DVec3> {
     (0..n)
         .map(|_| {
             let u = rng.next_f64();
-            let z = 1.0 - 2.0 * u;
-            let sin_theta = 2.0 * (u * (1.0 - u)).sqrt();
-            let (s, c) = (TAU * rng.next_f64()).sin_cos();
-            DVec3::new(sin_theta * c, sin_theta * s, z)
+            equal_area(DVec2::new(u, rng.next_f64()))
         })
         .collect()
+}
+
+/// Archimedes' equal-area map of `[0, 1)²` onto the unit sphere:
+/// `z = 1 − 2u.x`, azimuth `2π u.y`; `sin θ = 2√(u(1−u))` avoids
+/// cancellation near the poles. Uniform in, uniform out.
+///
+/// ```
+/// use tessera::baselines::equal_area;
+/// let v = equal_area(glam::DVec2::new(0.5, 0.25));
+/// assert!((v - glam::DVec3::Y).length() < 1e-15);
+/// ```
+pub fn equal_area(u: DVec2) -> DVec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let sin_theta = 2.0 * (u.x * (1.0 - u.x)).sqrt();
+    let (s, c) = (TAU * u.y).sin_cos();
+    DVec3::new(sin_theta * c, sin_theta * s, z)
 }
 
 /// Largest f64 below 1.
@@ -216,4 +232,24 @@ pub fn jittered_healpix(nside: usize, seed: u64) -> Vec<DVec3> {
         }
     }
     out
+}
+
+/// Bridson's Poisson-disk sampling of the unit square (the `fast_poisson`
+/// crate) with the radius `√(0.7 / n)` that gives about `n` points (the
+/// count varies with the seed; a maximal set at this radius holds about
+/// 0.7 / r² points).
+///
+/// ```
+/// let p = tessera::baselines::bridson(1000, 1);
+/// assert!((800..1200).contains(&p.len()));
+/// assert!(p.iter().all(|q| q.x >= 0.0 && q.x < 1.0 && q.y >= 0.0 && q.y < 1.0));
+/// ```
+pub fn bridson(n: usize, seed: u64) -> Vec<DVec2> {
+    let radius = (0.7 / n.max(1) as f64).sqrt();
+    fast_poisson::Poisson2D::new()
+        .with_dimensions([1.0, 1.0], radius)
+        .with_seed(seed)
+        .iter()
+        .map(|[x, y]| DVec2::new(x, y).min(DVec2::splat(BELOW_ONE)))
+        .collect()
 }

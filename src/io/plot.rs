@@ -128,9 +128,10 @@ pub fn equirectangular(points: &[DVec3], width: u32) -> GrayImage {
 /// # Example
 /// ```
 /// use glam::DVec3;
-/// let img = tessera::io::plot::orthographic(&[DVec3::X, -DVec3::X, DVec3::Z], 101, DVec3::X);
+/// let near_z = DVec3::new(0.1, 0.0, 1.0).normalize();
+/// let img = tessera::io::plot::orthographic(&[DVec3::X, -DVec3::X, near_z], 101, DVec3::X);
 /// assert_eq!(img.get_pixel(50, 50)[0], 0); // +x faces the viewer: the centre
-/// assert_eq!(img.get_pixel(50, 0)[0], 0); // +z: top of the disc
+/// assert_eq!(img.get_pixel(50, 0)[0], 0); // near +z: top of the disc
 /// ```
 pub fn orthographic(points: &[DVec3], size: u32, toward: DVec3) -> GrayImage {
     let (mut img, radius) = canvas(size, size, points.len() / 2);
