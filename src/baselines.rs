@@ -15,7 +15,7 @@ pub mod cdf;
 pub mod envmap;
 pub mod sobol;
 
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DQuat, DVec2, DVec3};
 use std::f64::consts::TAU;
 
 /// SplitMix64 (Steele, Lea & Flood 2014; Vigna's reference constants): a
@@ -252,4 +252,27 @@ pub fn bridson(n: usize, seed: u64) -> Vec<DVec2> {
         .iter()
         .map(|[x, y]| DVec2::new(x, y).min(DVec2::splat(BELOW_ONE)))
         .collect()
+}
+
+/// A rotation drawn uniformly (Haar measure) from `seed`: Shoemake's
+/// uniform unit quaternion from three [`SplitMix64`] numbers. Rotating a
+/// point set by it randomises the set without changing its geometry, which
+/// makes Monte Carlo estimates from it unbiased.
+///
+/// ```
+/// let r = tessera::baselines::random_rotation(3);
+/// assert!((r.determinant() - 1.0).abs() < 1e-12);
+/// assert!(((r * glam::DVec3::X).length() - 1.0).abs() < 1e-12);
+/// ```
+pub fn random_rotation(seed: u64) -> DMat3 {
+    let mut rng = SplitMix64::new(seed);
+    let (u1, u2, u3) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let q = DQuat::from_xyzw(
+        a * (TAU * u2).sin(),
+        a * (TAU * u2).cos(),
+        b * (TAU * u3).sin(),
+        b * (TAU * u3).cos(),
+    );
+    DMat3::from_quat(q.normalize())
 }

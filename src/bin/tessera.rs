@@ -40,6 +40,31 @@ enum Command {
     Metrics(MetricsArgs),
     /// Render a point file as a PNG picture.
     Plot(PlotArgs),
+    /// Measurements: `bench accuracy` writes ACCURACY.md and its plots.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Relative RMSE of Monte Carlo integration against time, every sampler
+    /// and knob, N = 2^6 .. 2^20: writes OUT/ACCURACY.md and OUT/accuracy-*.png.
+    Accuracy(AccuracyArgs),
+}
+
+#[derive(Args)]
+struct AccuracyArgs {
+    /// Directory for ACCURACY.md and the plots.
+    #[arg(long, default_value = "docs")]
+    out: PathBuf,
+    /// Largest N is 2^this (from 2^6).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(7..=24))]
+    max_exponent: u32,
+    /// Seeds per method and N.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u64).range(2..))]
+    seeds: u64,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -294,6 +319,9 @@ fn main() -> ExitCode {
         } => lut_tiling(args),
         Command::Metrics(args) => metrics(args),
         Command::Plot(args) => plot(args),
+        Command::Bench {
+            command: BenchCommand::Accuracy(args),
+        } => bench_accuracy(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -714,6 +742,28 @@ fn plot(args: PlotArgs) -> Result<(), Error> {
             save_png(&plot::orthographic(&points, args.size, toward), &args.png)
         }
     }
+}
+
+fn bench_accuracy(args: AccuracyArgs) -> Result<(), Error> {
+    let config = tessera::accuracy::Config {
+        exponents: (6..=args.max_exponent).collect(),
+        seeds: args.seeds,
+    };
+    let results = tessera::accuracy::run(&config);
+    let command = format!(
+        "tessera bench accuracy --out {} --max-exponent {} --seeds {}",
+        args.out.display(),
+        args.max_exponent,
+        args.seeds
+    );
+    let files = results.write(&args.out, &command)?;
+    eprintln!(
+        "wrote {} files into {} in {:.0} s",
+        files.len(),
+        args.out.display(),
+        results.wall_seconds
+    );
+    Ok(())
 }
 
 fn lut_tiling(args: LutTilingArgs) -> Result<(), Error> {

@@ -6,6 +6,7 @@
 
 pub mod plane;
 pub mod polyomino;
+pub mod reference;
 pub mod sphere;
 
 /// A tile's threshold code (see [`TileSystem`]). Wide enough for the

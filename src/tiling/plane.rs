@@ -465,3 +465,10 @@ impl TileSystem for PlaneTiling {
         self.position(tile, self.bin(fraction))
     }
 }
+
+impl super::reference::ReferencePoint for PlaneTiling {
+    fn reference(&self, tile: &PlaneTile) -> DVec2 {
+        let p = self.to_unit(tile, self.lut.shape.centroid());
+        DVec2::new(wrap(p.x), wrap(p.y))
+    }
+}
