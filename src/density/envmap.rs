@@ -768,6 +768,7 @@ impl Density<SphereRegion> for EnvMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::baselines::SplitMix64;
     use crate::healpix::vec_to_angles;
 
     #[test]
