@@ -4,8 +4,8 @@
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
-use fast_poisson::Poisson2D;
 use std::hint::black_box;
+use tessera::baselines::bridson;
 use tessera::density::{plane::Ramp, Uniform};
 use tessera::engine;
 use tessera::tiling::penrose::PenroseTiling;
@@ -26,15 +26,6 @@ fn systems() -> [(&'static str, PlaneTiling); 2] {
         ("ghexomino", PlaneTiling::ghexomino()),
         ("ppentomino", PlaneTiling::ppentomino()),
     ]
-}
-
-/// Bridson with the radius that gives about `n` points in the unit square.
-fn bridson(n: usize, seed: u64) -> Vec<[f64; 2]> {
-    let radius = (0.7 / n as f64).sqrt();
-    Poisson2D::new()
-        .with_dimensions([1.0, 1.0], radius)
-        .with_seed(seed)
-        .generate()
 }
 
 /// `N` samples at uniform density and on the ramp.

@@ -1,6 +1,7 @@
 //! Baseline point sets to compare samplers against: the spherical Fibonacci
-//! lattice, independent uniform points on the sphere and in the square, and
-//! the jittered grid, with a small self-contained RNG ([`SplitMix64`]) so
+//! lattice, independent uniform points on the sphere and in the square, the
+//! jittered grid and jittered HEALPix, Owen-scrambled Sobol ([`sobol`])
+//! warped by inverse CDFs ([`cdf`], [`envmap`]), with a small self-contained RNG ([`SplitMix64`]) so
 //! that results are reproducible from a seed without extra dependencies.
 //!
 //! ```
@@ -10,9 +11,11 @@
 //! assert_eq!(jittered_grid_2d(3, 0).len(), 9);
 //! ```
 
+pub mod cdf;
 pub mod envmap;
+pub mod sobol;
 
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DQuat, DVec2, DVec3};
 use std::f64::consts::TAU;
 
 /// SplitMix64 (Steele, Lea & Flood 2014; Vigna's reference constants): a
@@ -142,12 +145,25 @@ pub fn uniform_random_sphere(n: usize, seed: u64) -> Vec<DVec3> {
     (0..n)
         .map(|_| {
             let u = rng.next_f64();
-            let z = 1.0 - 2.0 * u;
-            let sin_theta = 2.0 * (u * (1.0 - u)).sqrt();
-            let (s, c) = (TAU * rng.next_f64()).sin_cos();
-            DVec3::new(sin_theta * c, sin_theta * s, z)
+            equal_area(DVec2::new(u, rng.next_f64()))
         })
         .collect()
+}
+
+/// Archimedes' equal-area map of `[0, 1)²` onto the unit sphere:
+/// `z = 1 − 2u.x`, azimuth `2π u.y`; `sin θ = 2√(u(1−u))` avoids
+/// cancellation near the poles. Uniform in, uniform out.
+///
+/// ```
+/// use tessera::baselines::equal_area;
+/// let v = equal_area(glam::DVec2::new(0.5, 0.25));
+/// assert!((v - glam::DVec3::Y).length() < 1e-15);
+/// ```
+pub fn equal_area(u: DVec2) -> DVec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let sin_theta = 2.0 * (u.x * (1.0 - u.x)).sqrt();
+    let (s, c) = (TAU * u.y).sin_cos();
+    DVec3::new(sin_theta * c, sin_theta * s, z)
 }
 
 /// Largest f64 below 1.
@@ -216,4 +232,47 @@ pub fn jittered_healpix(nside: usize, seed: u64) -> Vec<DVec3> {
         }
     }
     out
+}
+
+/// Bridson's Poisson-disk sampling of the unit square (the `fast_poisson`
+/// crate) with the radius `√(0.7 / n)` that gives about `n` points (the
+/// count varies with the seed; a maximal set at this radius holds about
+/// 0.7 / r² points).
+///
+/// ```
+/// let p = tessera::baselines::bridson(1000, 1);
+/// assert!((800..1200).contains(&p.len()));
+/// assert!(p.iter().all(|q| q.x >= 0.0 && q.x < 1.0 && q.y >= 0.0 && q.y < 1.0));
+/// ```
+pub fn bridson(n: usize, seed: u64) -> Vec<DVec2> {
+    let radius = (0.7 / n.max(1) as f64).sqrt();
+    fast_poisson::Poisson2D::new()
+        .with_dimensions([1.0, 1.0], radius)
+        .with_seed(seed)
+        .iter()
+        .map(|[x, y]| DVec2::new(x, y).min(DVec2::splat(BELOW_ONE)))
+        .collect()
+}
+
+/// A rotation drawn uniformly (Haar measure) from `seed`: Shoemake's
+/// uniform unit quaternion from three [`SplitMix64`] numbers. Rotating a
+/// point set by it randomises the set without changing its geometry, which
+/// makes Monte Carlo estimates from it unbiased.
+///
+/// ```
+/// let r = tessera::baselines::random_rotation(3);
+/// assert!((r.determinant() - 1.0).abs() < 1e-12);
+/// assert!(((r * glam::DVec3::X).length() - 1.0).abs() < 1e-12);
+/// ```
+pub fn random_rotation(seed: u64) -> DMat3 {
+    let mut rng = SplitMix64::new(seed);
+    let (u1, u2, u3) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let q = DQuat::from_xyzw(
+        a * (TAU * u2).sin(),
+        a * (TAU * u2).cos(),
+        b * (TAU * u3).sin(),
+        b * (TAU * u3).cos(),
+    );
+    DMat3::from_quat(q.normalize())
 }

@@ -13,6 +13,7 @@
 //! assert_eq!(points.len(), 500);
 //! ```
 
+pub mod accuracy;
 pub mod baselines;
 pub mod density;
 pub mod engine;

@@ -160,3 +160,98 @@ fn bad_input_gets_a_clear_error_and_no_panic() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn plot_and_metrics_png() {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-png-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    stdout(&["sphere", "-n", "500", "-o", &path("s.xyz")]);
+    stdout(&[
+        "plane",
+        "--system",
+        "ghexomino",
+        "-n",
+        "500",
+        "-o",
+        &path("p.txt"),
+    ]);
+    stdout(&[
+        "plot",
+        "sphere",
+        &path("s.xyz"),
+        "--png",
+        &path("eq.png"),
+        "--size",
+        "200",
+    ]);
+    let ortho = [
+        "plot",
+        "sphere",
+        &path("s.xyz"),
+        "--png",
+        &path("o.png"),
+        "--view",
+        "ortho",
+        "--toward",
+        "-30,45",
+        "--size",
+        "120",
+    ];
+    stdout(&ortho);
+    stdout(&[
+        "plot",
+        "plane",
+        &path("p.txt"),
+        "--png",
+        &path("st.png"),
+        "--size",
+        "128",
+    ]);
+    let json = stdout(&[
+        "metrics",
+        "plane",
+        &path("p.txt"),
+        "--json",
+        "--spectrum",
+        "--png",
+        &path("ps.png"),
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(v["radial_average"].as_array().unwrap().len() >= 16);
+    assert!(v["low_frequency_power"].as_f64().unwrap() < 1.0);
+    let json = stdout(&[
+        "metrics",
+        "sphere",
+        &path("s.xyz"),
+        "--json",
+        "--spectrum",
+        "--png",
+        &path("ap.png"),
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["angular_power"].as_array().unwrap().len(), 65);
+    for (name, size) in [
+        ("eq.png", (200, 100)),
+        ("o.png", (120, 120)),
+        ("st.png", (128, 128)),
+        ("ps.png", (768, 256)),
+        ("ap.png", (640, 360)),
+    ] {
+        let img = image::open(dir.join(name)).unwrap();
+        assert_eq!((img.width(), img.height()), size, "{name}");
+    }
+    let bad = tessera(&[
+        "plot",
+        "sphere",
+        &path("s.xyz"),
+        "--png",
+        &path("x.png"),
+        "--view",
+        "ortho",
+        "--toward",
+        "north",
+    ]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--toward 'north'"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

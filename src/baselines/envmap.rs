@@ -15,6 +15,7 @@
 //! }
 //! ```
 
+use crate::baselines::cdf::GridCdf;
 use crate::baselines::SplitMix64;
 use crate::density::envmap::EnvMap;
 use glam::DVec3;
@@ -34,28 +35,6 @@ fn draw(n: usize, seed: u64, sample: impl Fn([f64; 4]) -> DVec3) -> Vec<DVec3> {
         .collect()
 }
 
-/// Index `k` with `cdf[k] <= u < cdf[k + 1]` (never a zero-width entry).
-fn search(cdf: &[f64], u: f64) -> usize {
-    cdf[1..].partition_point(|&c| c <= u).min(cdf.len() - 2)
-}
-
-/// Running sums of `weights` divided by their total (`None` when it is 0),
-/// with the last entry exactly 1.
-fn normalised_cdf(weights: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
-    let mut cdf = vec![0.0];
-    let mut sum = 0.0;
-    for w in weights {
-        sum += w;
-        cdf.push(sum);
-    }
-    if sum <= 0.0 {
-        return None;
-    }
-    cdf.iter_mut().for_each(|c| *c /= sum);
-    *cdf.last_mut().expect("non-empty") = 1.0;
-    Some(cdf)
-}
-
 /// Inverse-CDF sampling of a lat-long map.
 ///
 /// # Example
@@ -67,11 +46,8 @@ fn normalised_cdf(weights: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
 /// ```
 pub struct InverseCdf<'a> {
     map: &'a EnvMap,
-    /// Over rows: `height + 1` entries.
-    marginal: Vec<f64>,
-    /// Over the columns of each row: `width + 1` entries per row (a zero
-    /// row is never chosen and keeps a uniform CDF).
-    conditional: Vec<f64>,
+    /// Over pixel weights value x solid angle.
+    cdf: GridCdf,
 }
 
 impl<'a> InverseCdf<'a> {
@@ -84,24 +60,13 @@ impl<'a> InverseCdf<'a> {
     /// assert!(InverseCdf::new(&map).samples(10, 3).iter().all(|d| d.y >= 0.0));
     /// ```
     pub fn new(map: &'a EnvMap) -> Self {
-        let (w, h) = (map.width(), map.height());
-        let values = map.values();
-        let mut conditional = Vec::with_capacity(h * (w + 1));
-        let mut row_weights = Vec::with_capacity(h);
-        for j in 0..h {
-            let row = &values[j * w..(j + 1) * w];
-            row_weights.push(row.iter().sum::<f64>() * map.pixel_solid_angle(j));
-            let cdf = normalised_cdf(row.iter().copied())
-                .unwrap_or_else(|| (0..=w).map(|k| k as f64 / w as f64).collect());
-            conditional.extend(cdf);
-        }
-        let marginal =
-            normalised_cdf(row_weights.into_iter()).expect("an EnvMap has a positive integral");
-        InverseCdf {
-            map,
-            marginal,
-            conditional,
-        }
+        let w = map.width();
+        let weights: Vec<f64> = (map.values().iter().enumerate())
+            .map(|(k, v)| v * map.pixel_solid_angle(k / w))
+            .collect();
+        let cdf =
+            GridCdf::new(w, map.height(), &weights).expect("an EnvMap has a positive integral");
+        InverseCdf { map, cdf }
     }
 
     /// The direction for four uniform numbers in `[0, 1)`: row, column,
@@ -114,10 +79,24 @@ impl<'a> InverseCdf<'a> {
     /// assert!(InverseCdf::new(&map).sample([0.9, 0.2, 0.3, 0.4]).z < 0.0);
     /// ```
     pub fn sample(&self, u: [f64; 4]) -> DVec3 {
-        let w = self.map.width();
-        let j = search(&self.marginal, u[0]);
-        let i = search(&self.conditional[j * (w + 1)..(j + 1) * (w + 1)], u[1]);
+        let (i, j, _) = self.cdf.locate([u[0], u[1]]);
         self.map.direction_in_pixel(i, j, u[2], u[3])
+    }
+
+    /// The direction for two numbers in `[0, 1)`: row and column by the
+    /// CDFs, the position inside the pixel from where each fell in its
+    /// CDF entry, so a stratified `(u_row, u_column)` (Sobol) stays
+    /// stratified.
+    ///
+    /// # Example
+    /// ```
+    /// # use tessera::{baselines::envmap::InverseCdf, density::envmap::{EnvMap, Up}, io::image::Raster};
+    /// let map = EnvMap::new(Raster { width: 2, height: 2, values: vec![1.0; 4], bad_pixels: 0 }, Up::Z).unwrap();
+    /// assert!(InverseCdf::new(&map).warp([0.1, 0.7]).z > 0.0);
+    /// ```
+    pub fn warp(&self, u: [f64; 2]) -> DVec3 {
+        let (i, j, [a, b]) = self.cdf.locate(u);
+        self.map.direction_in_pixel(i, j, a, b)
     }
 
     /// `n` independent samples from a seed.

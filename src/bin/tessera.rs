@@ -38,6 +38,33 @@ enum Command {
     },
     /// Quality measures of a point file (text formats tessera writes, or UTK binary).
     Metrics(MetricsArgs),
+    /// Render a point file as a PNG picture.
+    Plot(PlotArgs),
+    /// Measurements: `bench accuracy` writes ACCURACY.md and its plots.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Relative RMSE of Monte Carlo integration against time, every sampler
+    /// and knob, N = 2^6 .. 2^20: writes OUT/ACCURACY.md and OUT/accuracy-*.png.
+    Accuracy(AccuracyArgs),
+}
+
+#[derive(Args)]
+struct AccuracyArgs {
+    /// Directory for ACCURACY.md and the plots.
+    #[arg(long, default_value = "docs")]
+    out: PathBuf,
+    /// Largest N is 2^this (from 2^6).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(7..=24))]
+    max_exponent: u32,
+    /// Seeds per method and N.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u64).range(2..))]
+    seeds: u64,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -58,6 +85,42 @@ struct MetricsArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Also print the spectrum: the angular power P(l), l = 0..64 (sphere),
+    /// or the periodogram's radial average and anisotropy (plane).
+    #[arg(long)]
+    spectrum: bool,
+    /// Write a PNG: the angular power spectrum plot (sphere), or the
+    /// periodogram image beside its radial average (plane).
+    #[arg(long)]
+    png: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct PlotArgs {
+    /// What the points live on.
+    #[arg(value_enum)]
+    domain: Domain,
+    /// The point file.
+    file: PathBuf,
+    /// The PNG to write.
+    #[arg(long)]
+    png: PathBuf,
+    /// Sphere view: equirectangular (lon/lat) or orthographic (the
+    /// hemisphere facing --toward).
+    #[arg(long, value_enum, default_value = "equirect")]
+    view: View,
+    /// Orthographic view direction `LON,LAT` in degrees.
+    #[arg(long, default_value = "0,0", allow_hyphen_values = true)]
+    toward: String,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1024)]
+    size: u32,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum View {
+    Equirect,
+    Ortho,
 }
 
 /// What every sampling command asks for: how many samples, and where to.
@@ -264,6 +327,10 @@ fn main() -> ExitCode {
             command: LutCommand::Tiling(args),
         } => lut_tiling(args),
         Command::Metrics(args) => metrics(args),
+        Command::Plot(args) => plot(args),
+        Command::Bench {
+            command: BenchCommand::Accuracy(args),
+        } => bench_accuracy(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -618,33 +685,77 @@ fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
     })
 }
 
+/// The points of a file as unit vectors, refusing any that are not.
+fn read_sphere_points(path: &Path) -> Result<Vec<glam::DVec3>, Error> {
+    let rows = tessera::io::points::read_points(path, 3)?;
+    let points: Vec<glam::DVec3> = rows
+        .iter()
+        .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
+        .collect();
+    match points
+        .iter()
+        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
+    {
+        Some(bad) => Err(Error::File {
+            path: path.into(),
+            reason: format!("point {} is not a unit vector", bad + 1),
+        }),
+        None => Ok(points),
+    }
+}
+
+fn read_plane_points(path: &Path) -> Result<Vec<glam::DVec2>, Error> {
+    let rows = tessera::io::points::read_points(path, 2)?;
+    Ok(rows.iter().map(|r| glam::DVec2::new(r[0], r[1])).collect())
+}
+
+fn save_png<P, C>(img: &image::ImageBuffer<P, C>, path: &Path) -> Result<(), Error>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+{
+    img.save_with_format(path, image::ImageFormat::Png)
+        .map_err(|e| Error::File {
+            path: path.into(),
+            reason: format!("cannot write PNG: {e}"),
+        })
+}
+
+/// Angular power spectrum degrees printed and plotted by `metrics sphere`.
+const SPECTRUM_L_MAX: usize = 64;
+
 fn metrics(args: MetricsArgs) -> Result<(), Error> {
-    let dims = match args.domain {
-        Domain::Sphere => 3,
-        Domain::Plane => 2,
-    };
-    let rows = tessera::io::points::read_points(&args.file, dims)?;
+    use tessera::io::plot;
     let report = match args.domain {
         Domain::Sphere => {
-            let points: Vec<glam::DVec3> = rows
-                .iter()
-                .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
-                .collect();
-            if let Some(bad) = points
-                .iter()
-                .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
-            {
-                return Err(Error::File {
-                    path: args.file.clone(),
-                    reason: format!("point {} is not a unit vector", bad + 1),
-                });
+            let points = read_sphere_points(&args.file)?;
+            let mut report = serde_json::to_value(tessera::metrics::sphere_report(&points));
+            if args.spectrum || args.png.is_some() {
+                let power = tessera::metrics::sphere::angular_power(&points, SPECTRUM_L_MAX);
+                if let Some(png) = &args.png {
+                    save_png(&plot::angular_power_figure(&power), png)?;
+                }
+                if let (true, Ok(serde_json::Value::Object(map))) = (args.spectrum, &mut report) {
+                    map.insert("angular_power".into(), power.into());
+                }
             }
-            serde_json::to_value(tessera::metrics::sphere_report(&points))
+            report
         }
         Domain::Plane => {
-            let points: Vec<glam::DVec2> =
-                rows.iter().map(|r| glam::DVec2::new(r[0], r[1])).collect();
-            serde_json::to_value(tessera::metrics::plane_report(&points))
+            let points = read_plane_points(&args.file)?;
+            let mut report = serde_json::to_value(tessera::metrics::plane_report(&points));
+            if args.spectrum || args.png.is_some() {
+                let spectrum = tessera::metrics::plane::PlaneSpectrum::new(&points);
+                if let Some(png) = &args.png {
+                    save_png(&plot::plane_spectrum_figure(&spectrum), png)?;
+                }
+                if let (true, Ok(serde_json::Value::Object(map))) = (args.spectrum, &mut report) {
+                    map.insert("radial_average".into(), spectrum.radial_average.into());
+                    map.insert("anisotropy_db".into(), spectrum.anisotropy.into());
+                }
+            }
+            report
         }
     }
     .expect("reports serialise");
@@ -655,6 +766,56 @@ fn metrics(args: MetricsArgs) -> Result<(), Error> {
             println!("{key:>24} {value}");
         }
     }
+    Ok(())
+}
+
+fn plot(args: PlotArgs) -> Result<(), Error> {
+    use tessera::io::plot;
+    match (args.domain, args.view) {
+        (Domain::Plane, _) => {
+            let points = read_plane_points(&args.file)?;
+            save_png(&plot::stipple(&points, args.size), &args.png)
+        }
+        (Domain::Sphere, View::Equirect) => {
+            let points = read_sphere_points(&args.file)?;
+            save_png(&plot::equirectangular(&points, args.size), &args.png)
+        }
+        (Domain::Sphere, View::Ortho) => {
+            let points = read_sphere_points(&args.file)?;
+            let bad = || {
+                Error::Request(format!(
+                    "--toward '{}': expected LON,LAT in degrees",
+                    args.toward
+                ))
+            };
+            let (lon, lat) = args.toward.split_once(',').ok_or_else(bad)?;
+            let parse = |s: &str| s.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+            let (lon, lat) = parse(lon).zip(parse(lat)).ok_or_else(bad)?;
+            let toward = tessera::density::sphere::lonlat_to_vec(lon, lat);
+            save_png(&plot::orthographic(&points, args.size, toward), &args.png)
+        }
+    }
+}
+
+fn bench_accuracy(args: AccuracyArgs) -> Result<(), Error> {
+    let config = tessera::accuracy::Config {
+        exponents: (6..=args.max_exponent).collect(),
+        seeds: args.seeds,
+    };
+    let results = tessera::accuracy::run(&config);
+    let command = format!(
+        "tessera bench accuracy --out {} --max-exponent {} --seeds {}",
+        args.out.display(),
+        args.max_exponent,
+        args.seeds
+    );
+    let files = results.write(&args.out, &command)?;
+    eprintln!(
+        "wrote {} files into {} in {:.0} s",
+        files.len(),
+        args.out.display(),
+        results.wall_seconds
+    );
     Ok(())
 }
 

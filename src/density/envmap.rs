@@ -27,12 +27,12 @@
 //! ```
 
 use super::Density;
-use crate::baselines::SplitMix64;
+use crate::baselines::random_rotation;
 use crate::healpix::FacePoint;
 use crate::io::image::{read_raster, Raster, ReadOptions};
 use crate::tiling::sphere::SphereRegion;
 use crate::Error;
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DMat3, DVec3};
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
@@ -413,18 +413,8 @@ impl EnvMap {
     /// assert_ne!(a[0].position, b[0].position);
     /// ```
     pub fn with_seed(&self, seed: u64) -> Self {
-        let mut rng = SplitMix64::new(seed);
-        let (u1, u2, u3) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
-        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        let q = DQuat::from_xyzw(
-            a * (TAU * u2).sin(),
-            a * (TAU * u2).cos(),
-            b * (TAU * u3).sin(),
-            b * (TAU * u3).cos(),
-        )
-        .normalize();
         EnvMap {
-            rotation: DMat3::from_quat(q),
+            rotation: random_rotation(seed),
             plain: false,
             ..self.clone()
         }
@@ -779,6 +769,7 @@ impl Density<SphereRegion> for EnvMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::baselines::SplitMix64;
     use crate::healpix::vec_to_angles;
 
     #[test]

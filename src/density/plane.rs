@@ -149,6 +149,28 @@ impl Raster {
         })
     }
 
+    /// Width and height in pixels.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::plane::Raster;
+    /// assert_eq!(Raster::new(3, 2, vec![1.0; 6], false).unwrap().dimensions(), (3, 2));
+    /// ```
+    pub fn dimensions(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The normalised pixel values (maximum 1), row-major.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::plane::Raster;
+    /// assert_eq!(Raster::new(2, 1, vec![1.0, 4.0], false).unwrap().values(), &[0.25, 1.0]);
+    /// ```
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
     /// The (normalised) importance of the pixel holding `point`.
     ///
     /// # Example

@@ -546,3 +546,49 @@ pub fn plane_report(points: &[DVec2]) -> PlaneReport {
         low_frequency_power: low_frequency_power(points),
     }
 }
+
+/// The periodogram of a point set on a grid sized to it, with its radial
+/// average and anisotropy (what `tessera metrics plane --spectrum` prints).
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::PlaneSpectrum;
+/// let s = PlaneSpectrum::new(&uniform_random_2d(256, 1));
+/// assert_eq!(s.periodogram.len(), s.size * s.size);
+/// assert_eq!(s.radial_average.len(), s.size / 2);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlaneSpectrum {
+    /// Side of the frequency grid.
+    pub size: usize,
+    /// [`periodogram`] on the grid.
+    pub periodogram: Vec<f64>,
+    /// [`radial_average`] of it.
+    pub radial_average: Vec<f64>,
+    /// [`anisotropy`] of it, in dB.
+    pub anisotropy: Vec<f64>,
+}
+
+impl PlaneSpectrum {
+    /// The spectrum on a grid of side `4√N` rounded up to a power of two,
+    /// between 32 and 256 (twice the blue-noise peak's radius `√N/2`...`√N`
+    /// fits); cost O(N · size²).
+    ///
+    /// ```
+    /// use tessera::baselines::jittered_grid_2d;
+    /// use tessera::metrics::plane::PlaneSpectrum;
+    /// assert_eq!(PlaneSpectrum::new(&jittered_grid_2d(16, 1)).size, 64);
+    /// ```
+    pub fn new(points: &[DVec2]) -> Self {
+        let size = ((4.0 * (points.len() as f64).sqrt()).ceil() as usize)
+            .next_power_of_two()
+            .clamp(32, 256);
+        let periodogram = periodogram(points, size);
+        PlaneSpectrum {
+            size,
+            radial_average: radial_average(&periodogram, size),
+            anisotropy: anisotropy(&periodogram, size),
+            periodogram,
+        }
+    }
+}

@@ -7,6 +7,7 @@
 pub mod penrose;
 pub mod plane;
 pub mod polyomino;
+pub mod reference;
 pub mod sphere;
 
 use crate::engine::Sample;

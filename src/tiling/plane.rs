@@ -610,3 +610,10 @@ pub fn deepest_level(side: Lattice, scale: Lattice, roots: Code, arity: Code) ->
         }
     }
 }
+
+impl super::reference::ReferencePoint for PlaneTiling {
+    fn reference(&self, tile: &PlaneTile) -> DVec2 {
+        let p = self.to_unit(tile, self.lut.shape.centroid());
+        DVec2::new(mirror_unit(p.x), mirror_unit(p.y))
+    }
+}

@@ -400,3 +400,9 @@ impl TileSystem for SphereTiling {
         self.face_point(tile, self.offset(tile, fraction)).to_vec()
     }
 }
+
+impl super::reference::ReferencePoint for SphereTiling {
+    fn reference(&self, tile: &SphereTile) -> DVec3 {
+        self.face_point(tile, self.centroid).to_vec()
+    }
+}

@@ -1,0 +1,476 @@
+//! Pictures a user looks at before reading numbers: planar stipples, sphere
+//! views (equirectangular and orthographic), periodogram images and line
+//! plots (linear or log-log, several series, ticks with small numeric
+//! labels). Pure functions returning image buffers; saving is the caller's.
+//!
+//! ```
+//! use tessera::io::plot::{line_plot, stipple, Axes, Series};
+//! let img = stipple(&[glam::DVec2::new(0.5, 0.5)], 64);
+//! assert_eq!(img.dimensions(), (64, 64));
+//! let s = Series { points: vec![(1.0, 1.0), (10.0, 0.1)], color: [200, 0, 0] };
+//! let plot = line_plot(&[s], Axes { log_x: true, log_y: true }, 320, 240);
+//! assert_eq!(plot.dimensions(), (320, 240));
+//! ```
+
+use glam::{DVec2, DVec3};
+use image::{GrayImage, Luma, Rgb, RgbImage};
+use std::f64::consts::{PI, TAU};
+
+/// Distinct colours for plot series, with [`PALETTE_NAMES`] for legends.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::io::plot::PALETTE.len(), tessera::io::plot::PALETTE_NAMES.len());
+/// ```
+pub const PALETTE: [[u8; 3]; 12] = [
+    [228, 26, 28],
+    [55, 126, 184],
+    [77, 175, 74],
+    [152, 78, 163],
+    [255, 127, 0],
+    [166, 86, 40],
+    [247, 129, 191],
+    [120, 120, 120],
+    [0, 0, 0],
+    [23, 190, 207],
+    [188, 189, 34],
+    [0, 0, 140],
+];
+
+/// Names of the [`PALETTE`] colours.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::io::plot::PALETTE_NAMES[0], "red");
+/// ```
+pub const PALETTE_NAMES: [&str; 12] = [
+    "red", "blue", "green", "purple", "orange", "brown", "pink", "grey", "black", "cyan", "olive",
+    "navy",
+];
+
+const WHITE: Luma<u8> = Luma([255]);
+const BLACK: Luma<u8> = Luma([0]);
+
+/// A white canvas; dots one pixel wide, or 3x3 when the set is sparse
+/// enough (at least 64 pixels per point) for them not to merge.
+fn canvas(width: u32, height: u32, n: usize) -> (GrayImage, i64) {
+    let radius = i64::from((width as usize * height as usize) >= 64 * n.max(1));
+    (GrayImage::from_pixel(width, height, WHITE), radius)
+}
+
+fn dot(img: &mut GrayImage, col: i64, row: i64, radius: i64, value: Luma<u8>) {
+    for r in row - radius..=row + radius {
+        for c in col - radius..=col + radius {
+            if (0..img.width() as i64).contains(&c) && (0..img.height() as i64).contains(&r) {
+                img.put_pixel(c as u32, r as u32, value);
+            }
+        }
+    }
+}
+
+/// Pixel index of coordinate `t` in `[0, 1]` on an axis of `len` pixels.
+fn pixel(t: f64, len: u32) -> i64 {
+    ((t * len as f64).floor() as i64).clamp(0, len as i64 - 1)
+}
+
+/// Black dots for points of `[0, 1)²` on a white `size x size` image, y up
+/// (point `(x, y)` lands in column `⌊x size⌋`, row `⌊(1 − y) size⌋`).
+///
+/// # Example
+/// ```
+/// let img = tessera::io::plot::stipple(&[glam::DVec2::new(0.1, 0.1)], 100);
+/// assert_eq!(img.get_pixel(10, 89)[0], 0);
+/// assert_eq!(img.get_pixel(50, 50)[0], 255);
+/// ```
+pub fn stipple(points: &[DVec2], size: u32) -> GrayImage {
+    let (mut img, radius) = canvas(size, size, points.len());
+    for p in points.iter().filter(|p| p.is_finite()) {
+        dot(
+            &mut img,
+            pixel(p.x, size),
+            pixel(1.0 - p.y, size),
+            radius,
+            BLACK,
+        );
+    }
+    img
+}
+
+/// Equirectangular view of points on the unit sphere, `width x width/2`:
+/// longitude `atan2(y, x)` from −180° (left edge) to 180°, colatitude from
+/// the north pole `+z` (top row) to the south pole.
+///
+/// # Example
+/// ```
+/// use glam::DVec3;
+/// let img = tessera::io::plot::equirectangular(&[DVec3::X, DVec3::Z], 200);
+/// assert_eq!(img.dimensions(), (200, 100));
+/// assert_eq!(img.get_pixel(100, 50)[0], 0); // +x: longitude 0 on the equator
+/// assert_eq!(img.get_pixel(100, 0)[0], 0); // the north pole
+/// ```
+pub fn equirectangular(points: &[DVec3], width: u32) -> GrayImage {
+    let height = (width / 2).max(1);
+    let (mut img, radius) = canvas(width, height, points.len());
+    for p in points.iter().filter(|p| p.is_finite()) {
+        let lon = (p.y + 0.0).atan2(p.x + 0.0); // + 0 turns −0 into +0: the poles at longitude 0
+        let colat = p.z.clamp(-1.0, 1.0).acos();
+        let (col, row) = (pixel((lon + PI) / TAU, width), pixel(colat / PI, height));
+        dot(&mut img, col, row, radius, BLACK);
+    }
+    img
+}
+
+/// Orthographic view (`size x size`) of the hemisphere facing a viewer far
+/// away in direction `toward`: the disc's outline in grey, the points with
+/// `p · toward > 0` in black. Screen up is the projection of `+z` (of `+x`
+/// when looking along the z axis), screen right completes the frame.
+///
+/// # Example
+/// ```
+/// use glam::DVec3;
+/// let near_z = DVec3::new(0.1, 0.0, 1.0).normalize();
+/// let img = tessera::io::plot::orthographic(&[DVec3::X, -DVec3::X, near_z], 101, DVec3::X);
+/// assert_eq!(img.get_pixel(50, 50)[0], 0); // +x faces the viewer: the centre
+/// assert_eq!(img.get_pixel(50, 0)[0], 0); // near +z: top of the disc
+/// ```
+pub fn orthographic(points: &[DVec3], size: u32, toward: DVec3) -> GrayImage {
+    let (mut img, radius) = canvas(size, size, points.len() / 2);
+    let f = toward.normalize();
+    let up = if f.z.abs() > 0.999 {
+        DVec3::X
+    } else {
+        DVec3::Z
+    };
+    let e2 = (up - up.dot(f) * f).normalize();
+    let e1 = e2.cross(f);
+    let to_pixel = |a: f64, b: f64| (pixel((1.0 + a) / 2.0, size), pixel((1.0 - b) / 2.0, size));
+    let steps = 8 * size as usize;
+    for k in 0..steps {
+        let (s, c) = (TAU * k as f64 / steps as f64).sin_cos();
+        let (col, row) = to_pixel(c, s);
+        dot(&mut img, col, row, 0, Luma([160]));
+    }
+    for p in points.iter().filter(|p| p.is_finite() && p.dot(f) > 0.0) {
+        let (col, row) = to_pixel(p.dot(e1), p.dot(e2));
+        dot(&mut img, col, row, radius, BLACK);
+    }
+    img
+}
+
+/// A `size x size` grid of non-negative values (row-major, row 0 at the
+/// bottom, as a periodogram's `ky` grows upward) as grey levels on a log
+/// scale between the 1st and 99th percentiles of the positive values
+/// (white: high). Non-positive and non-finite values are black.
+///
+/// # Example
+/// ```
+/// let img = tessera::io::plot::log_image(&[1.0, 10.0, 100.0, 0.0], 2);
+/// assert_eq!(img.get_pixel(0, 0)[0], 255); // value 100: top-left
+/// assert_eq!(img.get_pixel(0, 1)[0], 0); // value 1, bottom-left
+/// ```
+pub fn log_image(values: &[f64], size: usize) -> GrayImage {
+    let mut logs: Vec<f64> = values
+        .iter()
+        .filter(|v| v.is_finite() && **v > 0.0)
+        .map(|v| v.ln())
+        .collect();
+    logs.sort_by(f64::total_cmp);
+    let pick = |q: f64| logs.get(((logs.len() as f64 - 1.0) * q).round() as usize);
+    let (lo, hi) = (pick(0.01).copied(), pick(0.99).copied());
+    let side = size as u32;
+    let mut img = GrayImage::from_pixel(side, side, BLACK);
+    let (Some(lo), Some(hi)) = (lo, hi) else {
+        return img;
+    };
+    let span = (hi - lo).max(1e-300);
+    for (k, v) in values.iter().enumerate().take(size * size) {
+        if v.is_finite() && *v > 0.0 {
+            let t = ((v.ln() - lo) / span).clamp(0.0, 1.0);
+            let (col, row) = ((k % size) as u32, (size - 1 - k / size) as u32);
+            img.put_pixel(col, row, Luma([(t * 255.0).round() as u8]));
+        }
+    }
+    img
+}
+
+/// One curve of a [`line_plot`]: `(x, y)` points joined in order.
+///
+/// # Example
+/// ```
+/// let s = tessera::io::plot::Series { points: vec![(0.0, 1.0)], color: [0, 0, 0] };
+/// assert_eq!(s.points.len(), 1);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// The points, in drawing order.
+    pub points: Vec<(f64, f64)>,
+    /// RGB colour.
+    pub color: [u8; 3],
+}
+
+/// Axis scales of a [`line_plot`].
+///
+/// # Example
+/// ```
+/// let loglog = tessera::io::plot::Axes { log_x: true, log_y: true };
+/// assert!(loglog.log_x);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Axes {
+    /// Logarithmic x axis (non-positive x are dropped).
+    pub log_x: bool,
+    /// Logarithmic y axis (non-positive y are dropped).
+    pub log_y: bool,
+}
+
+/// One axis: data range (after the log when logarithmic) and pixel span.
+struct Scale {
+    log: bool,
+    lo: f64,
+    hi: f64,
+}
+
+impl Scale {
+    fn new(log: bool, values: impl Iterator<Item = f64>) -> Self {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in values.filter_map(|v| Self::map(log, v)) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if lo > hi {
+            (lo, hi) = (0.0, 1.0);
+        }
+        let pad = if hi > lo { 0.04 * (hi - lo) } else { 0.5 };
+        Scale {
+            log,
+            lo: lo - pad,
+            hi: hi + pad,
+        }
+    }
+
+    fn map(log: bool, v: f64) -> Option<f64> {
+        let m = if log { v.log10() } else { v };
+        (v.is_finite() && (!log || v > 0.0)).then_some(m)
+    }
+
+    /// Position in `[0, 1]` along the axis.
+    fn unit(&self, v: f64) -> Option<f64> {
+        Self::map(self.log, v).map(|m| (m - self.lo) / (self.hi - self.lo))
+    }
+
+    /// Tick positions (data values): decades on a log axis (every other
+    /// one when there are more than 8), else 1, 2 or 5 times a power of
+    /// ten giving 4 to 10 ticks.
+    fn ticks(&self) -> Vec<f64> {
+        if self.log {
+            let (a, b) = (self.lo.ceil() as i32, self.hi.floor() as i32);
+            let step = if b - a > 8 { 2 } else { 1 };
+            return (a..=b).step_by(step).map(|e| 10f64.powi(e)).collect();
+        }
+        let span = self.hi - self.lo;
+        let base = 10f64.powf((span / 10.0).log10().ceil());
+        let step = [0.2, 0.5, 1.0]
+            .iter()
+            .map(|m| m * base)
+            .find(|s| span / s <= 10.0)
+            .unwrap_or(base);
+        let first = (self.lo / step).ceil() as i64;
+        let last = (self.hi / step).floor() as i64;
+        (first..=last).map(|k| k as f64 * step).collect()
+    }
+}
+
+/// 3x5 bitmaps (bit 14 top-left, row-major) of the characters tick labels use.
+fn glyph(c: char) -> Option<u16> {
+    Some(match c {
+        '0' => 0b111_101_101_101_111,
+        '1' => 0b010_110_010_010_111,
+        '2' => 0b111_001_111_100_111,
+        '3' => 0b111_001_111_001_111,
+        '4' => 0b101_101_111_001_001,
+        '5' => 0b111_100_111_001_111,
+        '6' => 0b111_100_111_101_111,
+        '7' => 0b111_001_010_010_010,
+        '8' => 0b111_101_111_101_111,
+        '9' => 0b111_101_111_001_111,
+        '-' => 0b000_000_111_000_000,
+        '.' => 0b000_000_000_000_010,
+        'e' => 0b000_111_111_100_111,
+        _ => return None,
+    })
+}
+
+/// Draws `text` with its top-left corner at `(x, y)`, each font pixel 2x2.
+fn label(img: &mut RgbImage, text: &str, x: i64, y: i64) {
+    for (k, c) in text.chars().enumerate() {
+        let Some(bits) = glyph(c) else { continue };
+        for bit in 0..15 {
+            if bits >> (14 - bit) & 1 == 1 {
+                let (gx, gy) = (x + 8 * k as i64 + 2 * (bit % 3), y + 2 * (bit / 3));
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    put(img, gx + dx, gy + dy, [0, 0, 0]);
+                }
+            }
+        }
+    }
+}
+
+fn put(img: &mut RgbImage, x: i64, y: i64, color: [u8; 3]) {
+    if (0..img.width() as i64).contains(&x) && (0..img.height() as i64).contains(&y) {
+        img.put_pixel(x as u32, y as u32, Rgb(color));
+    }
+}
+
+/// Straight segment by sampling it every half pixel.
+fn segment(img: &mut RgbImage, a: (f64, f64), b: (f64, f64), color: [u8; 3]) {
+    let steps = (2.0 * (b.0 - a.0).abs().max((b.1 - a.1).abs()))
+        .ceil()
+        .max(1.0) as usize;
+    for k in 0..=steps {
+        let t = k as f64 / steps as f64;
+        let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+        put(img, x.round() as i64, y.round() as i64, color);
+    }
+}
+
+/// Tick label: `1e-3` style for decades, else the shortest plain number.
+fn tick_text(v: f64, log: bool) -> String {
+    if log {
+        format!("1e{}", v.log10().round() as i32)
+    } else {
+        let s = format!("{:.3}", v);
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// Several series on shared axes (`width x height`, white background):
+/// a frame, ticks with numeric labels, each series as joined points with
+/// 3x3 markers. Points that a log axis cannot show are dropped.
+///
+/// # Example
+/// ```
+/// use tessera::io::plot::{line_plot, Axes, Series};
+/// let s = Series { points: vec![(1.0, 1.0), (100.0, 0.01)], color: [255, 0, 0] };
+/// let img = line_plot(&[s], Axes { log_x: true, log_y: true }, 400, 300);
+/// assert!(img.pixels().any(|p| p.0 == [255, 0, 0]));
+/// ```
+pub fn line_plot(series: &[Series], axes: Axes, width: u32, height: u32) -> RgbImage {
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let sx = Scale::new(axes.log_x, all().map(|p| p.0));
+    let sy = Scale::new(axes.log_y, all().map(|p| p.1));
+    let mut img = RgbImage::from_pixel(width, height, Rgb([255, 255, 255]));
+    let (left, right, top, bottom) = (60.0, width as f64 - 12.0, 12.0, height as f64 - 30.0);
+    let to_px = |x: f64, y: f64| -> Option<(f64, f64)> {
+        let (u, v) = (sx.unit(x)?, sy.unit(y)?);
+        Some((left + u * (right - left), bottom - v * (bottom - top)))
+    };
+    let frame = [(left, top), (right, top), (right, bottom), (left, bottom)];
+    for k in 0..4 {
+        segment(&mut img, frame[k], frame[(k + 1) % 4], [0, 0, 0]);
+    }
+    for t in sx.ticks() {
+        if let Some(u) = sx.unit(t) {
+            let x = left + u * (right - left);
+            segment(&mut img, (x, bottom), (x, bottom - 6.0), [0, 0, 0]);
+            let text = tick_text(t, sx.log);
+            label(
+                &mut img,
+                &text,
+                x as i64 - 4 * text.len() as i64,
+                bottom as i64 + 6,
+            );
+        }
+    }
+    for t in sy.ticks() {
+        if let Some(v) = sy.unit(t) {
+            let y = bottom - v * (bottom - top);
+            segment(&mut img, (left, y), (left + 6.0, y), [0, 0, 0]);
+            let text = tick_text(t, sy.log);
+            label(
+                &mut img,
+                &text,
+                left as i64 - 4 - 8 * text.len() as i64,
+                y as i64 - 5,
+            );
+        }
+    }
+    for s in series {
+        let pts: Vec<(f64, f64)> = s.points.iter().filter_map(|p| to_px(p.0, p.1)).collect();
+        for w in pts.windows(2) {
+            segment(&mut img, w[0], w[1], s.color);
+        }
+        for &(x, y) in &pts {
+            for (dx, dy) in (-1..=1).flat_map(|dx| (-1..=1).map(move |dy| (dx, dy))) {
+                put(
+                    &mut img,
+                    x.round() as i64 + dx,
+                    y.round() as i64 + dy,
+                    s.color,
+                );
+            }
+        }
+    }
+    img
+}
+
+/// Figure for a planar point set's spectrum: the [`log_image`] of its
+/// periodogram (left, `size x size` pixels scaled to 256) beside the radial
+/// average against the frequency radius (right, linear axes, 1 = white noise
+/// drawn in grey).
+///
+/// # Example
+/// ```
+/// use tessera::{baselines::uniform_random_2d, metrics::plane::PlaneSpectrum};
+/// let img = tessera::io::plot::plane_spectrum_figure(&PlaneSpectrum::new(&uniform_random_2d(64, 1)));
+/// assert_eq!(img.dimensions(), (768, 256));
+/// ```
+pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) -> RgbImage {
+    let side = 256u32;
+    let grey = log_image(&spectrum.periodogram, spectrum.size);
+    let grey = image::imageops::resize(&grey, side, side, image::imageops::FilterType::Nearest);
+    let radial: Vec<(f64, f64)> = (1..spectrum.radial_average.len())
+        .map(|r| (r as f64, spectrum.radial_average[r]))
+        .collect();
+    let white = vec![(1.0, 1.0), (radial.len() as f64, 1.0)];
+    let series = [
+        Series {
+            points: white,
+            color: PALETTE[7],
+        },
+        Series {
+            points: radial,
+            color: PALETTE[1],
+        },
+    ];
+    let plot = line_plot(&series, Axes::default(), 2 * side, side);
+    let mut img = RgbImage::from_pixel(3 * side, side, Rgb([255, 255, 255]));
+    for (x, y, p) in grey.enumerate_pixels() {
+        img.put_pixel(x, y, Rgb([p[0]; 3]));
+    }
+    image::imageops::overlay(&mut img, &plot, i64::from(side), 0);
+    img
+}
+
+/// Plot of an angular power spectrum `P(l)` for `l ≥ 1` (linear axes;
+/// 1 = white noise drawn in grey).
+///
+/// # Example
+/// ```
+/// let img = tessera::io::plot::angular_power_figure(&[4.0, 0.5, 0.8, 1.1]);
+/// assert_eq!(img.dimensions(), (640, 360));
+/// ```
+pub fn angular_power_figure(power: &[f64]) -> RgbImage {
+    let curve: Vec<(f64, f64)> = (1..power.len()).map(|l| (l as f64, power[l])).collect();
+    let white = vec![(1.0, 1.0), (power.len().max(2) as f64 - 1.0, 1.0)];
+    let series = [
+        Series {
+            points: white,
+            color: PALETTE[7],
+        },
+        Series {
+            points: curve,
+            color: PALETTE[1],
+        },
+    ];
+    line_plot(&series, Axes::default(), 640, 360)
+}

@@ -1,0 +1,75 @@
+//! Pictures: PNGs decode at the right size and points land in the right pixels.
+
+use glam::{DVec2, DVec3};
+use tessera::io::plot::{
+    equirectangular, line_plot, log_image, orthographic, stipple, Axes, Series, PALETTE,
+};
+
+#[test]
+fn stipple_places_points_y_up() {
+    let img = stipple(&[DVec2::new(0.0, 0.0), DVec2::new(0.999, 0.999)], 50);
+    assert_eq!(img.dimensions(), (50, 50));
+    assert_eq!(img.get_pixel(0, 49)[0], 0);
+    assert_eq!(img.get_pixel(49, 0)[0], 0);
+    // 1250 pixels per point: 3x3 dots, the rest white
+    assert_eq!(img.pixels().filter(|p| p[0] == 0).count(), 2 * 4);
+}
+
+#[test]
+fn equirectangular_puts_directions_at_their_longitude_and_latitude() {
+    let img = equirectangular(&[-DVec3::Y, -DVec3::Z], 360);
+    assert_eq!(img.dimensions(), (360, 180));
+    // -y: longitude -90 degrees is a quarter of the width from the left
+    assert_eq!(img.get_pixel(90, 90)[0], 0);
+    assert_eq!(img.get_pixel(180, 179)[0], 0); // south pole, bottom row
+    assert_eq!(img.get_pixel(270, 90)[0], 255);
+}
+
+#[test]
+fn orthographic_hides_the_far_hemisphere() {
+    let img = orthographic(&[DVec3::Y, -DVec3::Z], 101, DVec3::Y);
+    assert_eq!(img.get_pixel(50, 50)[0], 0);
+    let seen = img.pixels().filter(|p| p[0] == 0).count();
+    assert_eq!(seen, 9, "only +y is in front (a 3x3 dot)");
+    // seen from +z, screen up is +x: +x sits at the top centre
+    let near_x = DVec3::new(1.0, 0.0, 0.1).normalize();
+    let top = orthographic(&[near_x], 101, DVec3::Z);
+    assert_eq!(top.get_pixel(50, 0)[0], 0);
+}
+
+#[test]
+fn log_image_orders_grey_levels_by_value() {
+    let img = log_image(&[1.0, 10.0, 100.0, 1000.0], 2);
+    let (a, b) = (img.get_pixel(0, 1)[0], img.get_pixel(1, 1)[0]);
+    let (c, d) = (img.get_pixel(0, 0)[0], img.get_pixel(1, 0)[0]);
+    assert!(a < b && b < c && c < d);
+}
+
+#[test]
+fn line_plot_draws_each_series_and_roundtrips_through_png() {
+    let rising = Series {
+        points: (1..=10).map(|k| (k as f64, k as f64)).collect(),
+        color: PALETTE[0],
+    };
+    let falling = Series {
+        points: (1..=10).map(|k| (k as f64, 1.0 / k as f64)).collect(),
+        color: PALETTE[1],
+    };
+    let img = line_plot(
+        &[rising, falling],
+        Axes {
+            log_x: true,
+            log_y: true,
+        },
+        300,
+        200,
+    );
+    for color in &PALETTE[..2] {
+        assert!(img.pixels().filter(|p| p.0 == *color).count() > 100);
+    }
+    let path = std::env::temp_dir().join(format!("tessera-plot-{}.png", std::process::id()));
+    img.save(&path).unwrap();
+    let back = image::open(&path).unwrap().to_rgb8();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(back, img);
+}
