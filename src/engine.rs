@@ -7,7 +7,8 @@
 //!         d = magnitude * average(tile) / mean
 //!         if code(tile) + 1/2 < d:
 //!             p = sample(tile, d / capacity(level))
-//!             if density varies and density(p) == 0: visit every child  (off the support)
+//!             if density varies and density(p) == 0: visit every child  (off the support;
+//!                 dropped when the tile has one child, which would re-place it)
 //!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
@@ -217,7 +218,9 @@ where
                 });
                 return;
             }
-            if level >= self.system.max_level() {
+            // a single child (a Penrose point) would only re-place the
+            // same sample: drop it, as the domain's edge does
+            if level >= self.system.max_level() || self.system.child_count(tile) <= 1 {
                 return;
             }
         }
