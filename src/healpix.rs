@@ -181,6 +181,7 @@ impl FacePoint {
         }
     }
 
+    #[inline(always)]
     fn zone(self) -> Result<(f64, f64, f64), DVec3> {
         let face = self.face % FACE_COUNT as u8;
         let x = self.x.clamp(0.0, 1.0);
@@ -290,7 +291,7 @@ impl FacePoint {
 
 /// `(z, sin(theta), a)` in the equatorial zone, from `Y = 3 z / 2` and the in-quadrant
 /// longitude `a`.
-#[inline]
+#[inline(always)]
 fn equatorial_zone(y_proj: f64, a: f64) -> (f64, f64, f64) {
     let z = 2.0 * y_proj / 3.0;
     (z, ((1.0 - z) * (1.0 + z)).sqrt(), a)
