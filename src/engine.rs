@@ -65,6 +65,14 @@ where
 }
 
 /// A conservative test of whether a tile (its region) reaches into a window.
+///
+/// # Example
+/// ```
+/// use tessera::{density::sphere::Cap, engine::Window, tiling::sphere::SphereRegion};
+/// let cap = Cap::new(0.0, 0.0, 1.0, 1.0).unwrap();
+/// let window: &Window<SphereRegion> = &|r| cap.reaches(r);
+/// # let _ = window;
+/// ```
 pub type Window<'a, R> = dyn Fn(&R) -> bool + Sync + 'a;
 
 /// What [`collect`] returns from the tiles `overlaps` accepts, in rank

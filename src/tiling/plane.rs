@@ -582,6 +582,12 @@ impl TileSystem for PlaneTiling {
 
 /// Lattice cells per unit-square edge beyond which f64 positions lose
 /// resolution: `2^40` keeps a cell thousands of ulps wide.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::plane::MAX_LATTICE_SIDE;
+/// assert_eq!(1.0 / MAX_LATTICE_SIDE as f64, 4096.0 * f64::EPSILON);
+/// ```
 pub const MAX_LATTICE_SIDE: Lattice = 1 << 40;
 
 /// The deepest level of a `side`-cell root patch refined by `scale` per
