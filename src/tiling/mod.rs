@@ -142,10 +142,7 @@ pub trait TileSystem: Sync {
         fraction: f64,
         d: f64,
     ) -> Option<Vec<Sample<Self::Point>>> {
-        self.map_code_order(level, count, &|code, tile| Sample {
-            position: self.sample(tile, fraction),
-            rank: code_value(code) / d,
-        })
+        samples_in_code_order(self, level, count, fraction, d)
     }
     /// Whether a terminal tile carries a sample. Penrose triangles only
     /// subdivide: its point tiles carry the samples.
@@ -188,4 +185,27 @@ pub(crate) fn mirror_unit(v: f64) -> f64 {
     // offsets move points less than a root tile, so one mirror suffices;
     // the largest f64 below 1 keeps the half-open square
     w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
+}
+
+/// [`TileSystem::code_order_samples`]'s default: every tile
+/// [`TileSystem::map_code_order`] yields, sampled (for systems that override
+/// the method and fall back to it).
+///
+/// # Example
+/// ```
+/// use tessera::tiling::{samples_in_code_order, sphere::SphereTiling};
+/// let s = samples_in_code_order(&SphereTiling::default(), 0, 3, 0.0125, 3.0).unwrap();
+/// assert_eq!(s.len(), 3);
+/// ```
+pub fn samples_in_code_order<S: TileSystem + ?Sized>(
+    system: &S,
+    level: u32,
+    count: usize,
+    fraction: f64,
+    d: f64,
+) -> Option<Vec<Sample<S::Point>>> {
+    system.map_code_order(level, count, &|code, tile| Sample {
+        position: system.sample(tile, fraction),
+        rank: code_value(code) / d,
+    })
 }

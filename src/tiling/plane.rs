@@ -16,7 +16,7 @@
 use crate::engine::Sample;
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
-use crate::tiling::{code_value, mirror_unit, Code, TileSystem};
+use crate::tiling::{code_value, mirror_unit, samples_in_code_order, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -509,10 +509,7 @@ impl TileSystem for PlaneTiling {
         d: f64,
     ) -> Option<Vec<Sample<DVec2>>> {
         if level < 2 || level > self.max_level || count as f64 > self.capacity(level) {
-            return self.map_code_order(level, count, &|code, tile| Sample {
-                position: self.sample(tile, fraction),
-                rank: code_value(code) / d,
-            });
+            return samples_in_code_order(self, level, count, fraction, d);
         }
         let (bin, s, a) = (
             self.bin(fraction),
