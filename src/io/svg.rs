@@ -157,14 +157,7 @@ pub fn plane_tiles(
         }
     }
     let radius = (side / tiling.cells_per_unit(level) / 4.0).max(0.6);
-    for p in points {
-        let _ = writeln!(
-            svg,
-            r#"<circle cx="{:.2}" cy="{:.2}" r="{radius:.2}" fill="red"/>"#,
-            p.x * side,
-            p.y * side
-        );
-    }
+    unit_square_points(&mut svg, points, side, radius);
     svg.push_str("</svg>\n");
     svg
 }
@@ -228,7 +221,13 @@ pub fn penrose_tiles(
             );
         }
     }
-    let radius = (edge / 8.0).max(0.6);
+    unit_square_points(&mut svg, points, side, (edge / 8.0).max(0.6));
+    svg.push_str("</g></svg>\n");
+    svg
+}
+
+/// Red dots for unit-square points on a `side`-pixel drawing.
+fn unit_square_points(svg: &mut String, points: &[glam::DVec2], side: f64, radius: f64) {
     for p in points {
         let _ = writeln!(
             svg,
@@ -237,6 +236,4 @@ pub fn penrose_tiles(
             p.y * side
         );
     }
-    svg.push_str("</g></svg>\n");
-    svg
 }
