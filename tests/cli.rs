@@ -114,6 +114,30 @@ fn large_uniform_requests_stream() {
 }
 
 #[test]
+fn a_window_writes_only_what_falls_in_it() {
+    // a 1e-6 degree cap 1e12 times brighter, in a 3e7-sample request: only
+    // the tiles reaching the window are visited
+    let args = [
+        "sphere",
+        "-n",
+        "30000000",
+        "--density",
+        "cap:0,90,1e-6,1e12",
+        "--within",
+        "0,90,1e-6",
+        "--format",
+        "lonlat",
+    ];
+    let text = stdout(&args);
+    let lats: Vec<f64> = text
+        .lines()
+        .map(|l| l.split(' ').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert!((2100..2400).contains(&lats.len()), "{}", lats.len());
+    assert!(lats.iter().all(|&lat| lat >= 90.0 - 1e-6));
+}
+
+#[test]
 fn bad_input_gets_a_clear_error_and_no_panic() {
     for (args, needle) in [
         (vec!["sphere", "-n", "abc"], "abc"),
@@ -137,6 +161,10 @@ fn bad_input_gets_a_clear_error_and_no_panic() {
             "cap:1,2",
         ),
         (vec!["sphere", "-n", "10", "--density", "blob"], "blob"),
+        (
+            vec!["sphere", "-n", "10", "--within", "0,90"],
+            "window '0,90'",
+        ),
         (vec!["sphere", "-n", "10", "--format", "pdf"], "pdf"),
         (vec!["sphere", "-n", "10", "--bogus"], "--bogus"),
         (vec!["metrics", "sphere", "/no/such/file"], "/no/such/file"),

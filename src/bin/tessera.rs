@@ -5,6 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use tessera::density::sphere::Cap;
 use tessera::io::points::SphereFormat;
 use tessera::tiling::sphere::SphereTiling;
 use tessera::{engine, Error};
@@ -153,6 +154,12 @@ struct SphereArgs {
     /// bin: UTK binary (f64, 3 dimensions).
     #[arg(long, default_value = "xyz")]
     format: String,
+    /// Write only the samples of the request that fall in this cap,
+    /// `LON,LAT,RADIUS_DEG`: only the tiles reaching it are visited, so a
+    /// small window on a huge request costs what the window holds. The count
+    /// is the expected one (exactness is a property of the whole set).
+    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with = "map")]
+    within: Option<String>,
     /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
     /// luminance per unit solid angle, constant per pixel. Replaces --density.
     #[arg(long, conflicts_with = "density")]
@@ -371,8 +378,23 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
+    let window = args.within.as_deref().map(Cap::window).transpose()?;
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(&tiling, args.request.count) {
+        // a window visits only the tiles reaching it
+        _ if window.is_some() => {
+            let window = window.expect("a window");
+            let near =
+                engine::collect_within(&tiling, &*density, args.request.count as f64, &|r| {
+                    window.reaches(r)
+                });
+            let inside = near
+                .iter()
+                .map(|s| s.position)
+                .filter(|&p| window.contains(p));
+            let points: Vec<glam::DVec3> = inside.collect();
+            tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        }
         // large uniform requests stream: memory stays O(depth)
         Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
             let points = stream.map(|s| s.position);

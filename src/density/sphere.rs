@@ -116,6 +116,26 @@ impl Cap {
         angle_between(self.center, v) <= self.radius
     }
 
+    /// A window `LON,LAT,RADIUS_DEG` (degrees), as a cap of contrast 1: for
+    /// [`Cap::reaches`] and [`Cap::contains`].
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::sphere::Cap;
+    /// assert!(Cap::window("0,90,1").unwrap().contains(glam::DVec3::Z));
+    /// assert!(Cap::window("0,90").is_err());
+    /// ```
+    pub fn window(spec: &str) -> Result<Self, Error> {
+        let window = || -> Result<Self, Error> {
+            let [lon, lat, radius] = numbers(spec, spec, "LON,LAT,RADIUS_DEG")?;
+            Cap::new(lon, lat, radius, 1.0)
+        };
+        window().map_err(|e| match e {
+            Error::Density(_, why) => Error::Request(format!("window '{spec}': {why}")),
+            other => other,
+        })
+    }
+
     /// Whether a tile may reach into the cap (conservative: true when the
     /// tile's bounding cap meets this one). A window for
     /// [`crate::engine::collect_within`].
@@ -297,15 +317,20 @@ pub fn parse(spec: &str) -> Result<Box<dyn Density<SphereRegion> + Send>, Error>
 /// The four numbers `LON,LAT,RADIUS_DEG,CONTRAST` of a `cap:` specification
 /// (`args` is what follows the prefix), shared by every parser of caps.
 pub(crate) fn cap_numbers(spec: &str, args: &str) -> Result<[f64; 4], Error> {
-    let fail = |why: &str| Error::Density(spec.to_string(), why.to_string());
+    numbers(spec, args, "cap:LON,LAT,RADIUS_DEG,CONTRAST")
+}
+
+/// `N` comma-separated numbers, or an error naming `spec` and the `usage`.
+fn numbers<const N: usize>(spec: &str, args: &str, usage: &str) -> Result<[f64; N], Error> {
+    let fail = |why: String| Error::Density(spec.to_string(), why);
     let numbers: Vec<f64> = args
         .split(',')
         .map(|s| s.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| fail("expected numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))?;
+        .map_err(|_| fail(format!("expected numbers: {usage}")))?;
     numbers[..]
         .try_into()
-        .map_err(|_| fail("expected 4 numbers: cap:LON,LAT,RADIUS_DEG,CONTRAST"))
+        .map_err(|_| fail(format!("expected {N} numbers: {usage}")))
 }
 
 /// The mean of `f` over the sphere by the equal-area quadrature of the
