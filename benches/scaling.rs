@@ -16,7 +16,7 @@ use std::hint::black_box;
 use std::time::Duration;
 use tessera::baselines::envmap::{AliasTable, InverseCdf};
 use tessera::baselines::{
-    bridson, jittered_healpix, sobol, spherical_fibonacci, spherical_fibonacci_into,
+    bridson, jittered_healpix_about, sobol, spherical_fibonacci, spherical_fibonacci_into,
     uniform_random_2d, uniform_random_sphere,
 };
 use tessera::density::plane::Ramp;
@@ -118,7 +118,7 @@ fn sphere(c: &mut Criterion) {
         sobol::sphere(n, 1)
     });
     baseline(c, "sphere/uniform", "jittered_healpix", &IN_MEMORY, |n| {
-        jittered_healpix(((n as f64 / 12.0).sqrt().round() as usize).max(1), 1)
+        jittered_healpix_about(n, 1)
     });
     let cap = Cap::new(0.0, 45.0, 30.0, 10.0).expect("cap");
     tile_system(c, "sphere/cap", "tessera", &tiling, &cap, &IN_MEMORY[..2]);

@@ -20,12 +20,19 @@ where
         assert_eq!(plain.code(root), system.code(root));
         moved += usize::from(system.sample(root, 1.0) != system.reference(root));
     }
-    assert!(moved * 2 > roots.len(), "offsets move most samples off the centroid");
+    assert!(
+        moved * 2 > roots.len(),
+        "offsets move most samples off the centroid"
+    );
     let a = engine::generate(&plain, &Uniform, 700, true).unwrap();
     let b = engine::generate(&system, &Uniform, 700, true).unwrap();
     assert_eq!(a.len(), 700);
     let ranks = |s: &[tessera::Sample<S::Point>]| s.iter().map(|x| x.rank).collect::<Vec<_>>();
-    assert_eq!(ranks(&a), ranks(&b), "same tiles accepted in the same order");
+    assert_eq!(
+        ranks(&a),
+        ranks(&b),
+        "same tiles accepted in the same order"
+    );
 }
 
 #[test]

@@ -15,7 +15,7 @@
 use super::{integrands, Generator, Method, Scenario};
 use crate::baselines::envmap::{AliasTable, InverseCdf};
 use crate::baselines::{
-    bridson, jittered_grid_2d, jittered_healpix, random_rotation, sobol, spherical_fibonacci,
+    bridson, jittered_grid_2d, jittered_healpix_about, random_rotation, sobol, spherical_fibonacci,
     uniform_random_2d, uniform_random_sphere, SplitMix64,
 };
 use crate::density::envmap::EnvMap;
@@ -113,10 +113,7 @@ pub(super) fn sphere_uniform<'a>() -> Scenario<'a, DVec3> {
         method("fibonacci", false, |n, seed| {
             rotate(spherical_fibonacci(n), seed)
         }),
-        method("jittered-healpix", false, |n, seed| {
-            let nside = ((n as f64 / 12.0).sqrt().round() as usize).max(1);
-            jittered_healpix(nside, seed)
-        }),
+        method("jittered-healpix", false, jittered_healpix_about),
     ]);
     Scenario {
         name: "sphere-uniform",
