@@ -1,13 +1,16 @@
-//! Planar throughput: tessera's polyomino systems at uniform density and on
-//! the ramp, one thread, against Bridson's Poisson-disk sampler
+//! Planar throughput: tessera's Penrose and polyomino systems at uniform
+//! density and on the ramp, one thread, against Bridson's Poisson-disk sampler
 //! (`fast_poisson`) in the same run. Run: `cargo bench --bench plane`.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use std::hint::black_box;
 use tessera::baselines::bridson;
 use tessera::density::{plane::Ramp, Uniform};
 use tessera::engine;
-use tessera::tiling::plane::PlaneTiling;
+use tessera::tiling::penrose::PenroseTiling;
+use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
+use tessera::tiling::TileSystem;
 
 const N: usize = 2_000_000;
 
@@ -25,19 +28,32 @@ fn systems() -> [(&'static str, PlaneTiling); 2] {
     ]
 }
 
+/// `N` samples at uniform density and on the ramp.
+fn uniform_and_ramp<S>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    pool: &rayon::ThreadPool,
+    name: &str,
+    tiling: &S,
+) where
+    S: TileSystem<Point = glam::DVec2, Region = PlaneRegion>,
+{
+    group.bench_function(format!("{name}_uniform"), |b| {
+        b.iter(|| pool.install(|| black_box(engine::generate(tiling, &Uniform, N, true))))
+    });
+    group.bench_function(format!("{name}_ramp"), |b| {
+        b.iter(|| pool.install(|| black_box(engine::generate(tiling, &Ramp, N, true))))
+    });
+}
+
 fn throughput(c: &mut Criterion) {
     let pool = one_thread();
     let mut group = c.benchmark_group("plane_1_thread");
     group.sample_size(10);
     group.throughput(Throughput::Elements(N as u64));
     for (name, tiling) in systems() {
-        group.bench_function(format!("{name}_uniform"), |b| {
-            b.iter(|| pool.install(|| black_box(engine::generate(&tiling, &Uniform, N, true))))
-        });
-        group.bench_function(format!("{name}_ramp"), |b| {
-            b.iter(|| pool.install(|| black_box(engine::generate(&tiling, &Ramp, N, true))))
-        });
+        uniform_and_ramp(&mut group, &pool, name, &tiling);
     }
+    uniform_and_ramp(&mut group, &pool, "penrose", &PenroseTiling::default());
     let bridson_n = bridson(N / 10, 1).len();
     group.throughput(Throughput::Elements(bridson_n as u64));
     group.bench_function("bridson_fast_poisson", |b| {

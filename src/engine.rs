@@ -7,11 +7,16 @@
 //!         d = magnitude * average(tile) / mean
 //!         if code(tile) + 1/2 < d:
 //!             p = sample(tile, d / capacity(level))
-//!             if density varies and density(p) == 0: visit every child  (off the support)
+//!             if density varies and density(p) == 0: visit every child  (off the support;
+//!                 dropped when the tile has one child, which would re-place it)
 //!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
-//! `magnitude` is the expected sample count over the whole domain, `mean`
+//! Tiles that carry no sample (Penrose's triangles) stop at the terminal
+//! test, and a sample the system places outside its domain is dropped
+//! ([`TileSystem::sample_in_domain`]).
+//! `magnitude` is the expected sample count over the whole domain (in code
+//! units: times [`TileSystem::codes_per_sample`]), `mean`
 //! the density's mean over it (dividing first keeps densities anywhere in
 //! 1e-300..1e300, subnormals included, from overflowing). Ranks order the output progressively: the samples with rank
 //! below `s` are those an `s`-times smaller request accepts, so every prefix
@@ -19,7 +24,7 @@
 //! gathered in order, so the output does not depend on the thread count.
 
 use crate::density::{Density, Region};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::{code_value, Code, TileSystem};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -56,11 +61,53 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    collect_parts(system, density, magnitude).concat()
+    collect_parts(system, density, magnitude, None).concat()
+}
+
+/// A conservative test of whether a tile (its region) reaches into a window.
+pub type Window<'a, R> = dyn Fn(&R) -> bool + Sync + 'a;
+
+/// What [`collect`] returns from the tiles `overlaps` accepts, in rank
+/// order, without visiting the others: a window on a huge request costs
+/// what the window holds, not what the request holds. `overlaps` must be
+/// conservative (true for every tile that reaches into the window);
+/// children of a rejected tile are never asked.
+///
+/// # Example
+/// ```
+/// use tessera::{density::{sphere::Cap, Uniform}, engine, tiling::sphere::SphereTiling};
+/// let sphere = SphereTiling::default();
+/// let window = Cap::new(30.0, 10.0, 5.0, 1.0).unwrap();
+/// let near = engine::collect_within(&sphere, &Uniform, 1e6, &|r| window.reaches(r));
+/// let all = engine::collect(&sphere, &Uniform, 1e6);
+/// let inside = |s: &&engine::Sample<glam::DVec3>| window.contains(s.position);
+/// assert_eq!(near.iter().filter(inside).count(), all.iter().filter(inside).count());
+/// assert!(near.len() < all.len() / 100);
+/// ```
+pub fn collect_within<S, D>(
+    system: &S,
+    density: &D,
+    magnitude: f64,
+    overlaps: &Window<'_, S::Region>,
+) -> Vec<Sample<S::Point>>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    by_rank(
+        collect_parts(system, density, magnitude, Some(overlaps)),
+        usize::MAX,
+    )
 }
 
 /// The accepted samples of each root's subtree, in root order.
-fn collect_parts<S, D>(system: &S, density: &D, magnitude: f64) -> Vec<Vec<Sample<S::Point>>>
+fn collect_parts<S, D>(
+    system: &S,
+    density: &D,
+    magnitude: f64,
+    window: Option<&Window<'_, S::Region>>,
+) -> Vec<Vec<Sample<S::Point>>>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
@@ -69,9 +116,11 @@ where
     let walker = Walker {
         system,
         density,
-        magnitude,
+        // thresholds compare codes, so the request goes in code units
+        magnitude: magnitude * system.codes_per_sample(),
         mean: density.mean(),
         constant: density.constant(),
+        window,
     };
     let roots = system.roots();
     // under a constant density every root receives about the same share
@@ -88,12 +137,14 @@ where
         .collect()
 }
 
-struct Walker<'a, S, D: ?Sized> {
+struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
     magnitude: f64,
     mean: f64,
     constant: Option<f64>,
+    /// Only tiles this accepts are visited (see [`collect_within`]).
+    window: Option<&'a Window<'a, S::Region>>,
 }
 
 impl<S, D> Walker<'_, S, D>
@@ -108,23 +159,30 @@ where
     fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
         let capacity = self.system.capacity(level);
-        if capacity >= parent_bound && self.system.code(tile) as f64 + 0.5 >= parent_bound {
+        if capacity >= parent_bound && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
             return;
         }
-        let (bound, average, region) = match self.constant {
-            Some(c) => (c, Some(c), None),
-            None => {
-                let region = self.system.region(tile);
-                let (bound, average) = self.density.bound_and_average(&region);
-                (bound, average, Some(region))
+        let region =
+            (self.constant.is_none() || self.window.is_some()).then(|| self.system.region(tile));
+        if let (Some(window), Some(region)) = (self.window, &region) {
+            if !window(region) {
+                return;
             }
+        }
+        let (bound, average) = match (self.constant, &region) {
+            (Some(c), _) => (c, Some(c)),
+            (None, Some(region)) => self.density.bound_and_average(region),
+            (None, None) => unreachable!("a region exists whenever the density varies"),
         };
         let bound = self.magnitude * (bound / self.mean);
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
         }
         if capacity >= bound || level >= self.system.max_level() {
-            let code = self.system.code(tile) as f64;
+            if !self.system.carries_sample(tile) {
+                return;
+            }
+            let code = code_value(self.system.code(tile));
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
             }
@@ -143,7 +201,9 @@ where
             if d.is_nan() || code + 0.5 >= d {
                 return;
             }
-            let position = self.system.sample(tile, (d / capacity).min(1.0));
+            let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
+                return; // the tiling reaches past the domain there
+            };
             // an offset may carry a sample off the support of a partly lit
             // tile (a map lit in one pixel): then the tile's children place
             // it, the one sharing its code (and lit) keeping it
@@ -158,7 +218,9 @@ where
                 });
                 return;
             }
-            if level >= self.system.max_level() {
+            // a single child (a Penrose point) would only re-place the
+            // same sample: drop it, as the domain's edge does
+            if level >= self.system.max_level() || self.system.child_count(tile) <= 1 {
                 return;
             }
         }
@@ -166,7 +228,7 @@ where
         // skipped before they are built
         let child_rejects = self.system.capacity(level + 1) >= bound;
         for i in 0..self.system.child_count(tile) {
-            if child_rejects && self.system.child_code(tile, i) as f64 + 0.5 >= bound {
+            if child_rejects && code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
                 continue;
             }
             self.visit(&self.system.child(tile, i), bound, out);
@@ -222,11 +284,7 @@ where
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
-        let sample = |code: Code, tile: &S::Tile| Sample {
-            position: system.sample(tile, fraction),
-            rank: code as f64 / d,
-        };
-        if let Some(samples) = system.map_code_order(stream.level, count, &sample) {
+        if let Some(samples) = system.code_order_samples(stream.level, count, fraction, d) {
             return Ok(samples);
         }
     }
@@ -236,7 +294,7 @@ where
     } else {
         count as f64
     };
-    let mut parts = collect_parts(system, density, magnitude);
+    let mut parts = collect_parts(system, density, magnitude, None);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
         let found = total(&parts);
@@ -249,7 +307,7 @@ where
             (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
         };
         magnitude *= growth;
-        parts = collect_parts(system, density, magnitude);
+        parts = collect_parts(system, density, magnitude, None);
     }
     if exact && total(&parts) < count {
         return Err(Error::Request(format!(
@@ -376,8 +434,8 @@ pub struct Stream<'a, S: TileSystem> {
     level: u32,
     fraction: f64,
     d: f64,
-    next: u64,
-    end: u64,
+    next: Code,
+    end: Code,
 }
 
 /// A progressive stream of `count` uniform samples, if the system finds
@@ -399,7 +457,7 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
         fraction: d / system.capacity(level),
         d,
         next: 0,
-        end: count as u64,
+        end: count as Code,
     })
 }
 
@@ -413,7 +471,7 @@ impl<S: TileSystem> Iterator for Stream<'_, S> {
         let tile = self.system.tile_with_code(self.level, self.next)?;
         let sample = Sample {
             position: self.system.sample(&tile, self.fraction),
-            rank: self.next as f64 / self.d,
+            rank: code_value(self.next) / self.d,
         };
         self.next += 1;
         Some(sample)

@@ -147,8 +147,26 @@ impl FacePoint {
     /// ```
     #[inline(always)]
     pub fn z_phi(self) -> (f64, f64) {
+        let (z, _, phi) = self.z_sin_phi();
+        (z, phi)
+    }
+
+    /// `(z, sin(theta), phi)` of [`FacePoint::to_vec`]'s direction without
+    /// trigonometry (`sin(theta)` without the `1 - z` cancellation near the
+    /// poles), `phi` as in [`FacePoint::z_phi`].
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::healpix::FacePoint;
+    /// let p = FacePoint::new(1, 0.999, 0.998);
+    /// let (z, s, _) = p.z_sin_phi();
+    /// let v = p.to_vec();
+    /// assert!((s - v.x.hypot(v.y)).abs() < 1e-15 && (z - v.z).abs() < 1e-15);
+    /// ```
+    #[inline(always)]
+    pub fn z_sin_phi(self) -> (f64, f64, f64) {
         match self.zone() {
-            Ok((z, _, a)) => {
+            Ok((z, sin_theta, a)) => {
                 let phi = a + FRAC_PI_2 * ((self.face % FACE_COUNT as u8) % 4) as f64;
                 let phi = if phi < 0.0 {
                     phi + TAU
@@ -157,15 +175,12 @@ impl FacePoint {
                 } else {
                     phi
                 };
-                (z, phi)
+                (z, sin_theta, phi)
             }
-            Err(v) => (v.z, if v.z.is_nan() { f64::NAN } else { 0.0 }),
+            Err(v) => (v.z, 0.0 * v.z, if v.z.is_nan() { f64::NAN } else { 0.0 }),
         }
     }
 
-    /// `(z, sin(theta), longitude inside the face's quadrant)`, or the
-    /// direction itself at a pole (NaN for NaN coordinates).
-    #[inline(always)]
     fn zone(self) -> Result<(f64, f64, f64), DVec3> {
         let face = self.face % FACE_COUNT as u8;
         let x = self.x.clamp(0.0, 1.0);

@@ -4,7 +4,7 @@
 //! version; `luts/*.provenance.json` beside it records the command, seed,
 //! parameters and resulting metrics. `tessera lut build` regenerates both.
 
-use crate::tiling::polyomino::{Placement, Rule};
+use crate::tiling::polyomino::{Lattice, Placement, Rule};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};
@@ -335,7 +335,7 @@ pub struct PlaneLut {
     /// `child_digit[rule][child]`: the child's rank among its siblings.
     pub child_digit: Vec<Vec<u8>>,
     /// Side of the root patch in cells: the roots cover `[0, side)^2`.
-    pub side: i32,
+    pub side: Lattice,
     /// The root tiles.
     pub roots: Vec<Placement>,
     /// Rule of each root.
@@ -493,13 +493,13 @@ impl PlaneLut {
         {
             return bad("root tables have the wrong size");
         }
-        let mut covered: Vec<(i32, i32)> = self
+        let mut covered: Vec<(Lattice, Lattice)> = self
             .roots
             .iter()
             .flat_map(|p| p.cells(&self.shape).collect::<Vec<_>>())
             .collect();
         covered.sort_unstable();
-        let square: Vec<(i32, i32)> = (0..self.side)
+        let square: Vec<(Lattice, Lattice)> = (0..self.side)
             .flat_map(|x| (0..self.side).map(move |y| (x, y)))
             .collect();
         if covered != square {
@@ -578,6 +578,165 @@ pub fn plane_lut(system: PlaneSystem) -> Arc<PlaneLut> {
         Arc::new(
             PlaneLut::from_bytes(bytes)
                 .expect("the embedded planar tables are checked by the test suite"),
+        )
+    })
+    .clone()
+}
+
+/// Format version written into and required from Penrose tables.
+pub const PENROSE_LUT_VERSION: u32 = 1;
+
+/// Largest offset a Penrose table may hold, in edges of the tile's level:
+/// the optimiser's offsets stay well inside one edge; anything beyond this
+/// is a corrupt file.
+pub const PENROSE_MAX_OFFSET: f64 = 4.0;
+
+/// The Penrose system's corrective offsets: one per (structural index,
+/// importance index), in the point tile's frame, in edges of its level
+/// times [`PLANE_OFFSET_SCALE`].
+///
+/// # Example
+/// ```
+/// let lut = tessera::lut::penrose_lut();
+/// assert_eq!(lut.classes, 21);
+/// assert!(lut.bins >= 21);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PenroseLut {
+    /// Format version, [`PENROSE_LUT_VERSION`].
+    pub version: u32,
+    /// Seed the optimiser ran with.
+    pub seed: u64,
+    /// Structural indices: values of the code's six most significant
+    /// Fibonacci digits, `F(8) = 21`.
+    pub classes: u16,
+    /// Importance bins: bin `b` covers `[b, b + 1) / bins` of the
+    /// fractional part of `log_phi^2` of the density.
+    pub bins: u16,
+    /// Offsets, indexed `class * bins + bin`.
+    pub offsets: Vec<[i16; 2]>,
+}
+
+impl PenroseLut {
+    /// A table of zero offsets (the optimiser's starting point).
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::PenroseLut::zero(21);
+    /// assert_eq!(lut.offset(20, 20), [0.0, 0.0]);
+    /// ```
+    pub fn zero(bins: u16) -> Self {
+        PenroseLut {
+            version: PENROSE_LUT_VERSION,
+            seed: 0,
+            classes: 21,
+            bins,
+            offsets: vec![[0, 0]; 21 * bins as usize],
+        }
+    }
+
+    /// The offset (point tile frame, edges) of class `class` in bin `bin`.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::penrose_lut();
+    /// let [x, y] = lut.offset(0, 0);
+    /// assert!(x.hypot(y) <= tessera::lut::PENROSE_MAX_OFFSET);
+    /// ```
+    pub fn offset(&self, class: usize, bin: usize) -> [f64; 2] {
+        let [x, y] = self.offsets[class * self.bins as usize + bin];
+        [x as f64 / PLANE_OFFSET_SCALE, y as f64 / PLANE_OFFSET_SCALE]
+    }
+
+    /// Stores an offset (edges) for class `class` in bin `bin`, quantised.
+    ///
+    /// # Example
+    /// ```
+    /// let mut lut = tessera::lut::PenroseLut::zero(21);
+    /// lut.set_offset(3, 4, [0.25, -0.5]);
+    /// assert_eq!(lut.offset(3, 4), [0.25, -0.5]);
+    /// ```
+    pub fn set_offset(&mut self, class: usize, bin: usize, offset: [f64; 2]) {
+        self.offsets[class * self.bins as usize + bin] = PlaneLut::quantise(offset);
+    }
+
+    /// Decodes a table, checking its version, sizes and offsets.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::PenroseLut;
+    /// assert!(PenroseLut::from_bytes(&[1, 2, 3]).is_err());
+    /// let bytes = PenroseLut::zero(21).to_bytes();
+    /// assert!(PenroseLut::from_bytes(&bytes).is_ok());
+    /// ```
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, Error> {
+        let version = bytes.first().copied().unwrap_or(0) as u32;
+        if version != PENROSE_LUT_VERSION {
+            return Err(Error::Table(format!(
+                "Penrose table has format version {version}, this build reads version {PENROSE_LUT_VERSION}"
+            )));
+        }
+        let lut: PenroseLut = postcard::from_bytes(bytes)
+            .map_err(|e| Error::Table(format!("Penrose table does not decode: {e}")))?;
+        lut.validate()?;
+        Ok(lut)
+    }
+
+    /// Encodes the table.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{penrose_lut, PenroseLut};
+    /// let lut = penrose_lut();
+    /// assert_eq!(PenroseLut::from_bytes(&lut.to_bytes()).unwrap(), *lut);
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        postcard::to_allocvec(self).expect("serialising to memory cannot fail")
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        let bad = |what: String| Err(Error::Table(format!("Penrose table: {what}")));
+        if self.classes != 21 {
+            return bad(format!(
+                "{} structural indices; the six-digit Fibonacci codes give 21",
+                self.classes
+            ));
+        }
+        if self.bins < 2 || self.offsets.len() != 21 * self.bins as usize {
+            return bad(format!(
+                "{} offsets for {} bins; expected 21 per bin, at least 2 bins",
+                self.offsets.len(),
+                self.bins
+            ));
+        }
+        let limit = PENROSE_MAX_OFFSET * PLANE_OFFSET_SCALE;
+        if let Some(at) = self
+            .offsets
+            .iter()
+            .position(|o| (o[0] as f64).hypot(o[1] as f64) > limit)
+        {
+            return bad(format!(
+                "offset {at} reaches beyond {PENROSE_MAX_OFFSET} edges"
+            ));
+        }
+        Ok(())
+    }
+}
+
+static PENROSE_BYTES: &[u8] = include_bytes!("../luts/penrose.lut");
+
+/// The Penrose table shipped in `luts/penrose.lut`, decoded once.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::lut::penrose_lut().version, tessera::lut::PENROSE_LUT_VERSION);
+/// ```
+pub fn penrose_lut() -> Arc<PenroseLut> {
+    static LUT: OnceLock<Arc<PenroseLut>> = OnceLock::new();
+    LUT.get_or_init(|| {
+        Arc::new(
+            PenroseLut::from_bytes(PENROSE_BYTES)
+                .expect("the embedded luts/penrose.lut is checked by the test suite"),
         )
     })
     .clone()

@@ -147,3 +147,33 @@ where
         &self.system
     }
 }
+
+impl<S, D> Sampler<S, D>
+where
+    S: TileSystem<Point = glam::DVec2, Region = crate::tiling::plane::PlaneRegion>,
+    D: Density<crate::tiling::plane::PlaneRegion>,
+{
+    /// Runs a planar system on an axis-aligned rectangle instead of the
+    /// unit square: the density (given on the unit square) is stretched
+    /// over `rect`, and samples come back in the rectangle's coordinates.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::rectangle::Rectangle, tiling::penrose::PenroseTiling, Sampler};
+    /// let rect = Rectangle::new(-1.0, 0.0, 1.0, 1.0).unwrap();
+    /// let s = Sampler::new(PenroseTiling::default()).count(300).generate_on(&rect).unwrap();
+    /// assert_eq!(s.len(), 300);
+    /// assert!(s.iter().all(|p| rect.contains(p.position)));
+    /// ```
+    pub fn generate_on(
+        &self,
+        rect: &crate::density::rectangle::Rectangle,
+    ) -> Result<Vec<Sample<glam::DVec2>>, Error> {
+        let density = rect.restrict(&self.density);
+        let mut samples = engine::generate(&self.system, &density, self.count, self.exact)?;
+        for s in &mut samples {
+            s.position = rect.to_world(s.position);
+        }
+        Ok(samples)
+    }
+}

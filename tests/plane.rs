@@ -1,6 +1,9 @@
 //! Planar polyomino systems: quality, density following, exactness,
 //! domain, determinism and the shipped tables.
 
+mod common;
+
+use common::plane::{check_counts, in_domain, photograph, ramp_expected, raster_mass};
 use glam::DVec2;
 use proptest::prelude::*;
 use tessera::baselines::SplitMix64;
@@ -8,9 +11,9 @@ use tessera::density::plane::{Ramp, Raster};
 use tessera::density::{Density, Uniform};
 use tessera::engine;
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
-use tessera::metrics::plane::{low_frequency_power, min_distance, periodogram, radial_average};
-use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
-use tessera::tiling::TileSystem;
+use tessera::metrics::plane::{low_frequency_power, min_distance, spectral_peaks};
+use tessera::tiling::plane::{PlaneRegion, PlaneTiling, MAX_LATTICE_SIDE};
+use tessera::tiling::{Code, TileSystem};
 
 fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
     [
@@ -27,10 +30,6 @@ fn positions<D: Density<PlaneRegion> + ?Sized>(t: &PlaneTiling, d: &D, n: usize)
         .collect()
 }
 
-fn in_domain(p: &DVec2) -> bool {
-    (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)
-}
-
 #[test]
 fn uniform_4096_is_blue_noise() {
     for (system, tiling) in systems() {
@@ -38,38 +37,14 @@ fn uniform_4096_is_blue_noise() {
         let d = min_distance(&points);
         let low = low_frequency_power(&points);
         // the largest peak of the radially averaged spectrum up to |k| = 128
-        let size = 256;
-        let radial = radial_average(&periodogram(&points, size), size);
-        let (peak_at, peak) = radial
-            .iter()
-            .enumerate()
-            .skip(1)
-            .fold((0, 0.0f64), |b, (r, &v)| if v > b.1 { (r, v) } else { b });
+        let peaks = spectral_peaks(&points, 256);
+        let (peak_at, peak) = (peaks.radial_at, peaks.radial);
         println!(
             "{}: min distance {d:.3}, low-frequency power {low:.3}, radial peak {peak:.2} at |k| = {peak_at}",
             system.name()
         );
         assert!(d >= 0.55, "{}: normalised min distance {d}", system.name());
         assert!(low <= 0.10, "{}: low-frequency power {low}", system.name());
-    }
-}
-
-/// Counts per cell of a 16x16 grid against `expected(cell)`: every cell
-/// within 4 Poisson sigma (and 1 point of rounding).
-fn check_counts(points: &[DVec2], expected: impl Fn(usize, usize) -> f64, what: &str) {
-    let mut counts = [[0usize; 16]; 16];
-    for p in points {
-        counts[(p.y * 16.0) as usize][(p.x * 16.0) as usize] += 1;
-    }
-    for (row, line) in counts.iter().enumerate() {
-        for (col, &n) in line.iter().enumerate() {
-            let e = expected(col, row);
-            let sigma = e.sqrt().max(1.0);
-            assert!(
-                (n as f64 - e).abs() <= 4.0 * sigma + 1.0,
-                "{what}: cell ({col}, {row}) has {n} points, expected {e:.1}"
-            );
-        }
     }
 }
 
@@ -80,38 +55,8 @@ fn ramp_counts_follow_the_density() {
         let points = positions(&tiling, &Ramp, n);
         assert_eq!(points.len(), n);
         assert!(points.iter().all(in_domain));
-        // the ramp's mass over column c is (2c + 1) / 256 of the total
-        let expected = |col: usize, _| n as f64 * (2 * col + 1) as f64 / 256.0 / 16.0;
-        check_counts(&points, expected, system.name());
+        check_counts(&points, |col, _| ramp_expected(n, col), system.name());
     }
-}
-
-/// A photograph-like raster: smooth gradients, a bright disc, a dark
-/// square, texture and a few hot pixels, with a black band.
-fn photograph(width: usize, height: usize, seed: u64) -> Vec<f64> {
-    let mut rng = SplitMix64::new(seed);
-    let mut v = Vec::with_capacity(width * height);
-    for row in 0..height {
-        for col in 0..width {
-            let (x, y) = (col as f64 / width as f64, row as f64 / height as f64);
-            let mut g = 0.3 + 0.4 * x * (1.0 - y) + 0.1 * (12.0 * x).sin() * (9.0 * y).cos();
-            if (x - 0.65).powi(2) + (y - 0.35).powi(2) < 0.04 {
-                g += 0.5;
-            }
-            if (0.1..0.3).contains(&x) && (0.6..0.85).contains(&y) {
-                g *= 0.1;
-            }
-            g += 0.05 * rng.next_f64();
-            if rng.next_u64() % 4000 == 0 {
-                g = 1.0;
-            }
-            if row < height / 16 {
-                g = 0.0;
-            }
-            v.push(g.clamp(0.0, 1.0));
-        }
-    }
-    v
 }
 
 #[test]
@@ -119,26 +64,13 @@ fn photograph_counts_follow_the_raster() {
     let (w, h) = (96, 80);
     let pixels = photograph(w, h, 7);
     let raster = Raster::new(w, h, pixels.clone(), false).unwrap();
-    // the raster's exact mass per grid cell (pixels split between cells
-    // contribute by area)
-    let total: f64 = pixels.iter().sum();
-    let mass = |col: usize, row: usize| {
-        let mut m = 0.0;
-        for r in 0..h {
-            for c in 0..w {
-                let ox = overlap(c as f64 / w as f64, (c + 1) as f64 / w as f64, col);
-                let oy = overlap(r as f64 / h as f64, (r + 1) as f64 / h as f64, row);
-                m += pixels[r * w + c] * ox * oy;
-            }
-        }
-        m / total
-    };
+    let mass = raster_mass(&pixels, w, h);
     let n = 30_000;
     for (system, tiling) in systems() {
         let points = positions(&tiling, &raster, n);
         assert_eq!(points.len(), n);
         assert!(points.iter().all(in_domain));
-        check_counts(&points, |c, r| n as f64 * mass(c, r), system.name());
+        check_counts(&points, |c, r| n as f64 * mass[r][c], system.name());
         // nothing lands in the black band at the top, except from tiles
         // straddling its edge (tiles there are under 0.005 across)
         let edge = (h / 16) as f64 / h as f64;
@@ -150,11 +82,6 @@ fn photograph_counts_follow_the_raster() {
             system.name()
         );
     }
-}
-
-fn overlap(a: f64, b: f64, cell: usize) -> f64 {
-    let (lo, hi) = (cell as f64 / 16.0, (cell + 1) as f64 / 16.0);
-    (b.min(hi) - a.max(lo)).max(0.0) / (b - a)
 }
 
 #[test]
@@ -279,18 +206,27 @@ fn the_deepest_level_keeps_codes_and_points_apart() {
         let level = tiling.max_level();
         let lut = tiling.lut();
         // exact: the f64 capacity rounds at these sizes
-        let cap = lut.roots.len() as u128 * (lut.arity() as u128).pow(level);
-        assert!(cap <= u64::MAX as u128);
-        // and the level is the deepest: one more overflows codes or lattice
-        let side = lut.side as i128 * (lut.rules[0].scale as i128).pow(level + 1);
-        assert!(cap * lut.arity() as u128 > u64::MAX as u128 || side > i32::MAX as i128 / 2);
-        let cap = cap as u64;
+        let cap = lut.roots.len() as Code * (lut.arity() as Code).pow(level);
+        // the level is the deepest: one more leaves f64 resolution
+        let scale = lut.rules[0].scale;
+        let side = lut.side * scale.pow(level);
+        assert!(side <= MAX_LATTICE_SIDE && side * scale > MAX_LATTICE_SIDE);
         let mut seen = Vec::new();
-        for code in [0u64, 1, 2, cap / 2, cap - 1] {
+        for code in [0, 1, 2, cap / 3, cap / 2, cap - 1] {
             let tile = tiling.tile_with_code(level, code).unwrap();
             assert_eq!(tile.code, code);
             let p = tiling.sample(&tile, 1.0);
             assert!(in_domain(&p));
+            // the point lies in one of its tile's lattice cells
+            let cell = (
+                (p.x * side as f64).floor() as i64,
+                (p.y * side as f64).floor() as i64,
+            );
+            let cells: Vec<_> = tile.placement.cells(&lut.shape).collect();
+            assert!(
+                cells.contains(&cell),
+                "code {code}: {cell:?} not in {cells:?}"
+            );
             seen.push(p);
         }
         for i in 0..seen.len() {
@@ -329,9 +265,9 @@ fn shipped_tables_are_small_and_round_trip() {
 fn codes_of_a_level_are_a_permutation() {
     for (_, tiling) in systems() {
         let level = 1;
-        let mut codes: Vec<u64> = tiling.tiles(level).iter().map(|t| t.code).collect();
+        let mut codes: Vec<Code> = tiling.tiles(level).iter().map(|t| t.code).collect();
         codes.sort_unstable();
-        assert!(codes.iter().enumerate().all(|(i, &c)| c == i as u64));
+        assert!(codes.iter().enumerate().all(|(i, &c)| c == i as Code));
     }
 }
 
@@ -339,7 +275,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     #[test]
-    fn tile_with_code_finds_the_tile_holding_the_code(code in 0u64..1_000_000) {
+    fn tile_with_code_finds_the_tile_holding_the_code(code in 0u128..1_000_000) {
         for (_, tiling) in systems() {
             let level = (0..=tiling.max_level()).find(|&l| tiling.capacity(l) > code as f64).unwrap();
             let tile = tiling.tile_with_code(level, code).unwrap();

@@ -59,7 +59,7 @@ fn outlines_are_closed_unit_step_loops() {
 
 proptest! {
     #[test]
-    fn orientations_form_the_dihedral_group(a in 0usize..8, b in 0usize..8, x in -50i32..50, y in -50i32..50) {
+    fn orientations_form_the_dihedral_group(a in 0usize..8, b in 0usize..8, x in -50i64..50, y in -50i64..50) {
         let (a, b) = (Orientation::from_index(a), Orientation::from_index(b));
         prop_assert_eq!(a.then(b).apply((x, y)), b.apply(a.apply((x, y))));
         prop_assert_eq!(a.inverse().apply(a.apply((x, y))), (x, y));

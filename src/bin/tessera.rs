@@ -27,7 +27,7 @@ struct Cli {
 enum Command {
     /// Sample the unit sphere (HEALPix faces tiled by P-pentominoes).
     Sphere(SphereArgs),
-    /// Sample the unit square (G-hexomino or P-pentomino tilings).
+    /// Sample the unit square (Penrose, G-hexomino or P-pentomino tilings).
     Plane(PlaneArgs),
     /// Draw a tiling level and its samples as SVG.
     Tiles(TilesArgs),
@@ -188,6 +188,8 @@ enum UpAxis {
 #[derive(Clone, Copy, ValueEnum)]
 enum System {
     Sphere,
+    /// Penrose (six tile types, Fibonacci codes) on the unit square.
+    Penrose,
     /// G-hexomino, 81-rep, on the unit square.
     Ghexomino,
     /// P-pentomino, 4-rep, on the unit square.
@@ -198,7 +200,7 @@ impl System {
     /// The planar table of a planar system.
     fn plane(self) -> Option<tessera::lut::PlaneSystem> {
         match self {
-            System::Sphere => None,
+            System::Sphere | System::Penrose => None,
             System::Ghexomino => Some(tessera::lut::PlaneSystem::Ghexomino),
             System::Ppentomino => Some(tessera::lut::PlaneSystem::Ppentomino),
         }
@@ -207,6 +209,8 @@ impl System {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum PlaneKind {
+    /// Penrose: six tile types, scale 1/phi per level.
+    Penrose,
     /// G-hexomino, 81-rep.
     Ghexomino,
     /// P-pentomino, 4-rep.
@@ -232,6 +236,10 @@ struct PlaneArgs {
     /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions).
     #[arg(long, default_value = "txt")]
     format: String,
+    /// Sample the rectangle `x0,y0,x1,y1` instead of the unit square (the
+    /// density's unit square stretched over it).
+    #[arg(long)]
+    domain: Option<String>,
 }
 
 #[derive(Args)]
@@ -239,7 +247,8 @@ struct TilesArgs {
     /// Tile system to draw.
     #[arg(long, value_enum)]
     system: System,
-    /// Subdivision level (0..=5).
+    /// Subdivision level (sphere 0..=5, Penrose 0..=14, polyominoes up to
+    /// 200000 tiles).
     #[arg(long, default_value_t = 0)]
     level: u32,
     /// SVG file to write.
@@ -450,26 +459,49 @@ fn print_report(points: &[glam::DVec3]) {
 fn plane(args: PlaneArgs) -> Result<(), Error> {
     use tessera::lut::PlaneSystem;
     use tessera::tiling::plane::PlaneTiling;
+    let polyomino = |system| PlaneTiling::new(tessera::lut::plane_lut(system));
+    match args.system {
+        PlaneKind::Penrose => {
+            plane_with(&tessera::tiling::penrose::PenroseTiling::default(), &args)
+        }
+        PlaneKind::Ghexomino => plane_with(&polyomino(PlaneSystem::Ghexomino), &args),
+        PlaneKind::Ppentomino => plane_with(&polyomino(PlaneSystem::Ppentomino), &args),
+    }
+}
+
+fn plane_with<S>(tiling: &S, args: &PlaneArgs) -> Result<(), Error>
+where
+    S: tessera::tiling::TileSystem<
+        Point = glam::DVec2,
+        Region = tessera::tiling::plane::PlaneRegion,
+    >,
+{
     let format: tessera::io::points::PlaneFormat = args.format.parse()?;
     let density = tessera::density::plane::parse(&args.density, args.invert)?;
-    let tiling = PlaneTiling::new(tessera::lut::plane_lut(match args.system {
-        PlaneKind::Ghexomino => PlaneSystem::Ghexomino,
-        PlaneKind::Ppentomino => PlaneSystem::Ppentomino,
-    }));
+    let rect = args
+        .domain
+        .as_deref()
+        .map(tessera::density::rectangle::Rectangle::parse)
+        .transpose()?;
+    let (count, exact) = (args.request.count, !args.request.expected);
     let mut out = create(&args.request.output)?;
-    let written = match engine::stream(&tiling, args.request.count) {
+    let written = match engine::stream(tiling, count) {
         // large uniform requests stream: memory stays O(depth)
-        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
+        Some(stream) if density.constant().is_some() && rect.is_none() && count > STREAM_ABOVE => {
             tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format)
         }
         _ => {
-            let samples = engine::generate(
-                &tiling,
-                &*density,
-                args.request.count,
-                !args.request.expected,
-            )?;
-            tessera::io::points::write_plane(&mut out, samples.iter().map(|s| s.position), format)
+            let points: Vec<glam::DVec2> = match rect {
+                Some(rect) => engine::generate(tiling, &rect.restrict(&*density), count, exact)?
+                    .iter()
+                    .map(|s| rect.to_world(s.position))
+                    .collect(),
+                None => engine::generate(tiling, &*density, count, exact)?
+                    .iter()
+                    .map(|s| s.position)
+                    .collect(),
+            };
+            tessera::io::points::write_plane(&mut out, points, format)
         }
     };
     written
@@ -478,6 +510,9 @@ fn plane(args: PlaneArgs) -> Result<(), Error> {
 }
 
 fn tiles(args: TilesArgs) -> Result<(), Error> {
+    if let System::Penrose = args.system {
+        return penrose_tiles(args);
+    }
     let Some(system) = args.system.plane() else {
         return sphere_tiles(args);
     };
@@ -497,6 +532,26 @@ fn tiles(args: TilesArgs) -> Result<(), Error> {
             .map(|s| s.position)
             .collect();
     let svg = tessera::io::svg::plane_tiles(&tiling, args.level, &points);
+    std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
+}
+
+fn penrose_tiles(args: TilesArgs) -> Result<(), Error> {
+    let tiling = tessera::tiling::penrose::PenroseTiling::default();
+    if args.level > 14 {
+        return Err(Error::Request(format!(
+            "level {} of the Penrose tiling draws over 200000 tiles; at most level 14 is drawn",
+            args.level
+        )));
+    }
+    let tiles = tiling.tiles(args.level);
+    // the points of that level: every point tile's sample at full density
+    let count = tiles.iter().filter(|t| t.kind.is_point()).count();
+    let points: Vec<glam::DVec2> =
+        engine::generate(&tiling, &tessera::density::Uniform, count, true)?
+            .iter()
+            .map(|s| s.position)
+            .collect();
+    let svg = tessera::io::svg::penrose_tiles(&tiling, args.level, &points);
     std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
 }
 
@@ -546,15 +601,22 @@ fn write_table(
     Ok((table, path))
 }
 
-fn plane_lut_build(args: &LutBuildArgs, system: tessera::lut::PlaneSystem) -> Result<(), Error> {
-    let mut options = tessera::optimize::plane::BuildOptions::for_system(system);
-    options.seed = args.seed;
-    if let Some(iterations) = args.iterations {
-        options.iterations = iterations;
-    }
-    if let Some(bins) = args.bins {
-        options.bins = bins;
-    }
+/// An optimiser's result: the encoded table, its format version and what
+/// the build measured.
+type Built<R> = (Vec<u8>, u32, R);
+
+/// Runs an optimiser under a progress bar and writes `<name>.lut` and
+/// `<name>.provenance.json` (command, options, seconds, report, size).
+fn build_table<O, R>(
+    args: &LutBuildArgs,
+    name: &str,
+    options: &O,
+    build: impl FnOnce(&(dyn Fn(&str, u64, u64) + Sync)) -> Result<Built<R>, Error>,
+) -> Result<(), Error>
+where
+    O: serde::Serialize,
+    R: serde::Serialize,
+{
     let bar = progress_bar();
     let progress = |stage: &str, done: u64, total: u64| {
         bar.set_message(stage.to_string());
@@ -562,21 +624,20 @@ fn plane_lut_build(args: &LutBuildArgs, system: tessera::lut::PlaneSystem) -> Re
         bar.set_position(done);
     };
     let started = std::time::Instant::now();
-    let (lut, report) = tessera::optimize::plane::build(system, &options, &progress)?;
+    let (bytes, version, report) = build(&progress)?;
     bar.finish();
     let seconds = started.elapsed().as_secs_f64();
-    let bytes = lut.to_bytes();
     let provenance = serde_json::json!({
         "command": std::env::args().collect::<Vec<_>>().join(" "),
         "tessera_version": env!("CARGO_PKG_VERSION"),
-        "format_version": lut.version,
-        "system": system.name(),
+        "format_version": version,
+        "system": name,
         "options": options,
         "build_seconds": seconds,
         "report": report,
         "table_bytes": bytes.len(),
     });
-    let (table, path) = write_table(&args.out_dir, system.name(), &bytes, provenance)?;
+    let (table, path) = write_table(&args.out_dir, name, &bytes, provenance)?;
     eprintln!(
         "wrote {} and {} in {seconds:.1} s",
         table.display(),
@@ -586,50 +647,42 @@ fn plane_lut_build(args: &LutBuildArgs, system: tessera::lut::PlaneSystem) -> Re
 }
 
 fn lut_build(args: LutBuildArgs) -> Result<(), Error> {
-    match args.system.plane() {
-        Some(system) => plane_lut_build(&args, system),
-        None => {
-            let mut options = tessera::optimize::sphere::BuildOptions {
-                seed: args.seed,
-                ..Default::default()
-            };
-            if let Some(iterations) = args.iterations {
-                options.iterations = iterations;
-            }
-            if let Some(bins) = args.bins {
-                options.bins = u8::try_from(bins).map_err(|_| {
-                    Error::Request(format!("--bins {bins}: the sphere table holds at most 255"))
-                })?;
-            }
-            let bar = progress_bar();
-            let progress = |stage: &str, done: u64, total: u64| {
-                bar.set_message(stage.to_string());
-                bar.set_length(total);
-                bar.set_position(done);
-            };
-            let started = std::time::Instant::now();
-            let (lut, report) = tessera::optimize::sphere::build(&options, &progress)?;
-            bar.finish();
-            let seconds = started.elapsed().as_secs_f64();
-            let bytes = lut.to_bytes();
-            let provenance = serde_json::json!({
-                "command": std::env::args().collect::<Vec<_>>().join(" "),
-                "tessera_version": env!("CARGO_PKG_VERSION"),
-                "format_version": lut.version,
-                "options": options,
-                "build_seconds": seconds,
-                "report": report,
-                "table_bytes": bytes.len(),
-            });
-            let (table, path) = write_table(&args.out_dir, "sphere", &bytes, provenance)?;
-            eprintln!(
-                "wrote {} and {} in {seconds:.1} s",
-                table.display(),
-                path.display()
-            );
-            Ok(())
-        }
+    if let Some(system) = args.system.plane() {
+        let mut options = tessera::optimize::plane::BuildOptions::for_system(system);
+        options.seed = args.seed;
+        options.iterations = args.iterations.unwrap_or(options.iterations);
+        options.bins = args.bins.unwrap_or(options.bins);
+        return build_table(&args, system.name(), &options, |progress| {
+            let (lut, report) = tessera::optimize::plane::build(system, &options, progress)?;
+            Ok((lut.to_bytes(), lut.version, report))
+        });
     }
+    if let System::Penrose = args.system {
+        let mut options = tessera::optimize::penrose::BuildOptions {
+            seed: args.seed,
+            ..Default::default()
+        };
+        options.iterations = args.iterations.unwrap_or(options.iterations);
+        options.bins = args.bins.unwrap_or(options.bins);
+        return build_table(&args, "penrose", &options, |progress| {
+            let (lut, report) = tessera::optimize::penrose::build(&options, progress)?;
+            Ok((lut.to_bytes(), lut.version, report))
+        });
+    }
+    let mut options = tessera::optimize::sphere::BuildOptions {
+        seed: args.seed,
+        ..Default::default()
+    };
+    options.iterations = args.iterations.unwrap_or(options.iterations);
+    if let Some(bins) = args.bins {
+        options.bins = u8::try_from(bins).map_err(|_| {
+            Error::Request(format!("--bins {bins}: the sphere table holds at most 255"))
+        })?;
+    }
+    build_table(&args, "sphere", &options, |progress| {
+        let (lut, report) = tessera::optimize::sphere::build(&options, progress)?;
+        Ok((lut.to_bytes(), lut.version, report))
+    })
 }
 
 /// The points of a file as unit vectors, refusing any that are not.

@@ -592,15 +592,16 @@ impl EnvMap {
     /// touches every column.
     fn touched(&self, region: &SphereRegion) -> (usize, usize, usize, usize) {
         let px = &*self.pixels;
-        let m = if self.plain {
-            region.center
+        let (z, rxy, phi) = if self.plain {
+            // straight from face coordinates: no trigonometry
+            region.centroid.z_sin_phi()
         } else {
-            self.up.to_map(self.rotation * region.center)
+            let m = self.up.to_map(self.rotation * region.center());
+            let phi = fast_atan2(m.y, m.x);
+            let phi = if phi < 0.0 { phi + TAU } else { phi };
+            (m.z, (m.x * m.x + m.y * m.y).sqrt(), phi)
         };
-        let rxy = (m.x * m.x + m.y * m.y).sqrt();
-        let theta = fast_atan2(rxy, m.z);
-        let phi = fast_atan2(m.y, m.x);
-        let phi = if phi < 0.0 { phi + TAU } else { phi };
+        let theta = fast_atan2(rxy, z);
         // wider than the cap by the angles' error, so pixel edges never
         // round inwards
         let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;

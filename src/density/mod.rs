@@ -7,6 +7,7 @@
 
 pub mod envmap;
 pub mod plane;
+pub mod rectangle;
 pub mod region;
 pub mod sphere;
 

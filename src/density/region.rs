@@ -114,7 +114,7 @@ impl Shape {
     fn side(&self, region: &SphereRegion) -> Side {
         match self {
             Shape::Cap(c, r) => {
-                let d = angle_between(*c, region.center);
+                let d = angle_between(*c, region.center());
                 if d + region.radius <= *r {
                     Side::Inside
                 } else if d - region.radius > *r {
@@ -124,7 +124,7 @@ impl Shape {
                 }
             }
             Shape::Polygon(vertices, pbox) => {
-                let Some(tile) = cap_box(region.center, region.radius) else {
+                let Some(tile) = cap_box(region.center(), region.radius) else {
                     return Side::Unknown;
                 };
                 let shifted = |k: f64| [tile[0] + k, tile[1], tile[2] + k, tile[3]];
@@ -139,7 +139,7 @@ impl Shape {
                 let crossed = boxes.iter().filter(|b| overlaps(b)).any(|b| {
                     (0..n).any(|k| segment_meets_box(vertices[k], vertices[(k + 1) % n], *b))
                 });
-                match (crossed, self.contains(region.center)) {
+                match (crossed, self.contains(region.center())) {
                     (true, _) => Side::Unknown,
                     (false, true) => Side::Inside,
                     (false, false) => Side::Outside,

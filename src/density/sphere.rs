@@ -116,6 +116,22 @@ impl Cap {
         angle_between(self.center, v) <= self.radius
     }
 
+    /// Whether a tile may reach into the cap (conservative: true when the
+    /// tile's bounding cap meets this one). A window for
+    /// [`crate::engine::collect_within`].
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::sphere::Cap, tiling::{sphere::SphereTiling, TileSystem}};
+    /// let sphere = SphereTiling::default();
+    /// let cap = Cap::new(0.0, 90.0, 1.0, 1.0).unwrap();
+    /// let reached = sphere.roots().iter().filter(|t| cap.reaches(&sphere.region(t))).count();
+    /// assert!(reached >= 4 && reached < 20);
+    /// ```
+    pub fn reaches(&self, region: &SphereRegion) -> bool {
+        angle_between(self.center, region.center()) - region.radius <= self.radius
+    }
+
     /// The fraction of a sample set's expected mass that lies in the cap.
     ///
     /// # Example
@@ -131,7 +147,7 @@ impl Cap {
 
 impl Density<SphereRegion> for Cap {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        let distance = angle_between(self.center, region.center);
+        let distance = angle_between(self.center, region.center());
         if distance + region.radius <= self.radius {
             self.contrast
         } else if distance - region.radius > self.radius {
@@ -141,7 +157,7 @@ impl Density<SphereRegion> for Cap {
         }
     }
     fn average(&self, region: &SphereRegion) -> f64 {
-        let distance = angle_between(self.center, region.center);
+        let distance = angle_between(self.center, region.center());
         if distance + region.radius <= self.radius {
             return self.contrast;
         }
@@ -235,7 +251,7 @@ fn clean(v: f64) -> f64 {
 
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        clean((self.f)(region.center)) + self.lipschitz * region.radius
+        clean((self.f)(region.center())) + self.lipschitz * region.radius
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let probes = region.probes();

@@ -168,3 +168,75 @@ pub fn plane_tiles(
     svg.push_str("</svg>\n");
     svg
 }
+
+/// Draws the Penrose tiles of a level that reach the unit square (x to the
+/// right, y down), triangles filled by code rank (dark = kept first) and
+/// clipped to the square, each point tile's code beside its vertex when
+/// there are at most 400 of them, and the given points as dots.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::penrose::PenroseTiling;
+/// let svg = tessera::io::svg::penrose_tiles(&PenroseTiling::default(), 4, &[glam::DVec2::splat(0.5)]);
+/// assert!(svg.matches("<polygon").count() > 10);
+/// assert!(svg.contains("<text") && svg.contains("<circle"));
+/// ```
+pub fn penrose_tiles(
+    tiling: &crate::tiling::penrose::PenroseTiling,
+    level: u32,
+    points: &[glam::DVec2],
+) -> String {
+    let side = HEIGHT;
+    let tiles = tiling.tiles(level);
+    let capacity = tiling.capacity(level);
+    let edge = tiling.edge(level) * side;
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{side}" height="{side}" viewBox="0 0 {side} {side}">"#
+    );
+    let _ = writeln!(
+        svg,
+        r#"<defs><clipPath id="square"><rect width="{side}" height="{side}"/></clipPath></defs>"#
+    );
+    let _ = writeln!(
+        svg,
+        r#"<rect width="{side}" height="{side}" fill="white"/><g clip-path="url(#square)">"#
+    );
+    let stroke = (edge / 20.0).clamp(0.1, 1.0);
+    for tile in tiles.iter().filter(|t| !t.kind.is_point()) {
+        let mut path = String::new();
+        for p in tile.v {
+            let _ = write!(path, "{:.2},{:.2} ", p.x * side, p.y * side);
+        }
+        let grey = (40.0 + 200.0 * tile.code as f64 / capacity) as u8;
+        let _ = writeln!(
+            svg,
+            r#"<polygon points="{path}" fill="rgb({grey},{grey},255)" stroke="black" stroke-width="{stroke:.2}"/>"#
+        );
+    }
+    let vertices: Vec<_> = tiles.iter().filter(|t| t.kind.is_point()).collect();
+    if vertices.len() <= 400 {
+        let font = (edge * 0.3).max(4.0);
+        for t in vertices {
+            let _ = writeln!(
+                svg,
+                r#"<text x="{:.2}" y="{:.2}" font-size="{font:.2}">{}</text>"#,
+                t.v[0].x * side + font * 0.3,
+                t.v[0].y * side - font * 0.3,
+                t.code
+            );
+        }
+    }
+    let radius = (edge / 8.0).max(0.6);
+    for p in points {
+        let _ = writeln!(
+            svg,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="{radius:.2}" fill="red"/>"#,
+            p.x * side,
+            p.y * side
+        );
+    }
+    svg.push_str("</g></svg>\n");
+    svg
+}

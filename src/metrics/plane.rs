@@ -351,6 +351,65 @@ pub fn radial_average(periodogram: &[f64], size: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The largest spectral peaks of a point set up to `|k| = size / 2`, DC
+/// excluded: of the radially averaged power and of single frequencies.
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::spectral_peaks;
+/// let p = spectral_peaks(&uniform_random_2d(512, 1), 32);
+/// assert!(p.radial > 0.5 && p.radial < 3.0 && p.single >= p.radial);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SpectralPeaks {
+    /// Ring radius of the largest radially averaged power.
+    pub radial_at: usize,
+    /// That power (white noise: about 1).
+    pub radial: f64,
+    /// `|k|` of the largest single-frequency power.
+    pub single_at: f64,
+    /// That power.
+    pub single: f64,
+}
+
+/// Computes [`SpectralPeaks`] from a [`periodogram`] of side `size`.
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::spectral_peaks;
+/// // a 16 x 16 lattice: all power on the lattice frequencies (multiples of 16)
+/// let grid: Vec<DVec2> = (0..256)
+///     .map(|i| DVec2::new((i % 16) as f64 + 0.5, (i / 16) as f64 + 0.5) / 16.0)
+///     .collect();
+/// let p = spectral_peaks(&grid, 40);
+/// assert!((p.single_at - 16.0).abs() < 1e-9 && p.single > 200.0);
+/// ```
+pub fn spectral_peaks(points: &[DVec2], size: usize) -> SpectralPeaks {
+    let power = periodogram(points, size);
+    let radial = radial_average(&power, size);
+    let (radial_at, radial) = radial
+        .iter()
+        .enumerate()
+        .skip(1)
+        .fold((0, 0.0f64), |b, (r, &v)| if v > b.1 { (r, v) } else { b });
+    let k0 = k_min(size);
+    let (mut single_at, mut single) = (0.0, 0.0f64);
+    for (idx, &v) in power.iter().enumerate() {
+        let kx = (idx % size) as i64 + k0;
+        let ky = (idx / size) as i64 + k0;
+        let k = ((kx * kx + ky * ky) as f64).sqrt();
+        if k > 0.0 && k <= (size / 2) as f64 && v > single {
+            (single_at, single) = (k, v);
+        }
+    }
+    SpectralPeaks {
+        radial_at,
+        radial,
+        single_at,
+        single,
+    }
+}
+
 /// Ulichney's anisotropy of a [`periodogram`] of side `size`, in decibels:
 /// for each ring r of [`radial_average`], `10 log10(s²(r) / P_r(r)²)` with
 /// `s²` the unbiased variance (divisor `count − 1`) of the ring's values and

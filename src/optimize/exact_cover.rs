@@ -3,7 +3,7 @@
 //! Used offline to find polyomino dissections: the two 4-rep rules of the
 //! P-pentomino, the 20-tile patch of a 10x10 face, the 81-rep G-hexomino rule.
 
-use crate::tiling::polyomino::{Orientation, Placement, Shape};
+use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
 use std::collections::HashSet;
 
 /// Every placement of `shape` (any of the 8 orientations, any translation)
@@ -14,24 +14,25 @@ use std::collections::HashSet;
 /// use tessera::optimize::exact_cover::placements_in;
 /// use tessera::tiling::polyomino::Shape;
 /// let domino = Shape::new(vec![(0, 0), (1, 0)]);
-/// let square: Vec<(i32, i32)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
+/// let square: Vec<(i64, i64)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
 /// // two horizontal and two vertical dominoes fit in a 2x2 square
 /// assert_eq!(placements_in(&domino, &square).len(), 4);
 /// ```
-pub fn placements_in(shape: &Shape, region: &[(i32, i32)]) -> Vec<Placement> {
-    let cells: HashSet<(i32, i32)> = region.iter().copied().collect();
+pub fn placements_in(shape: &Shape, region: &[(Lattice, Lattice)]) -> Vec<Placement> {
+    let cells: HashSet<(Lattice, Lattice)> = region.iter().copied().collect();
     let mut seen = HashSet::new();
     let mut out = Vec::new();
     for orientation in Orientation::ALL {
         let at_origin = Placement::new((0, 0), orientation);
-        let base: Vec<(i32, i32)> = at_origin.cells(shape).collect();
+        let base: Vec<(Lattice, Lattice)> = at_origin.cells(shape).collect();
         // translate so that the first shape cell lands on every region cell
         for &anchor in region {
             let (dx, dy) = (anchor.0 - base[0].0, anchor.1 - base[0].1);
             if !base.iter().all(|c| cells.contains(&(c.0 + dx, c.1 + dy))) {
                 continue;
             }
-            let mut key: Vec<(i32, i32)> = base.iter().map(|c| (c.0 + dx, c.1 + dy)).collect();
+            let mut key: Vec<(Lattice, Lattice)> =
+                base.iter().map(|c| (c.0 + dx, c.1 + dy)).collect();
             key.sort_unstable();
             if seen.insert(key) {
                 out.push(Placement::new((dx, dy), orientation));
@@ -52,12 +53,12 @@ pub fn placements_in(shape: &Shape, region: &[(i32, i32)]) -> Vec<Placement> {
 /// use tessera::optimize::exact_cover::tilings;
 /// use tessera::tiling::polyomino::Shape;
 /// let domino = Shape::new(vec![(0, 0), (1, 0)]);
-/// let square: Vec<(i32, i32)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
+/// let square: Vec<(i64, i64)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
 /// assert_eq!(tilings(&domino, &square, usize::MAX, 0).len(), 2);
 /// ```
 pub fn tilings(
     shape: &Shape,
-    region: &[(i32, i32)],
+    region: &[(Lattice, Lattice)],
     limit: usize,
     order_seed: u64,
 ) -> Vec<Vec<Placement>> {
@@ -65,7 +66,7 @@ pub fn tilings(
     if order_seed != 0 {
         shuffle(&mut options, order_seed);
     }
-    let index: std::collections::HashMap<(i32, i32), usize> =
+    let index: std::collections::HashMap<(Lattice, Lattice), usize> =
         region.iter().enumerate().map(|(i, &c)| (c, i)).collect();
     let option_cells: Vec<Vec<usize>> = options
         .iter()

@@ -2,6 +2,8 @@
 //! produce the tables in `luts/`. Nothing here runs when sampling.
 
 pub mod exact_cover;
+mod lloyd;
+pub mod penrose;
 pub mod plane;
 pub mod ranking;
 pub mod sphere;

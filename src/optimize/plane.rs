@@ -24,9 +24,10 @@
 use crate::baselines::SplitMix64;
 use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
 use crate::optimize::exact_cover::tilings;
+use crate::optimize::lloyd::{cell_moments, torus_d2, wrap_half, TorusGrid};
 use crate::optimize::ranking::farthest_point_ranks;
 use crate::tiling::plane::{PlaneTile, PlaneTiling};
-use crate::tiling::polyomino::{Placement, Rule, Shape};
+use crate::tiling::polyomino::{Lattice, Placement, Rule, Shape};
 use crate::tiling::TileSystem;
 use crate::Error;
 use rayon::prelude::*;
@@ -234,8 +235,8 @@ fn root_patch(
     system: PlaneSystem,
     shape: &Shape,
     rng: &mut SplitMix64,
-) -> Result<(i32, Vec<Placement>), Error> {
-    let rect = |w: i32, h: i32| -> Vec<(i32, i32)> {
+) -> Result<(Lattice, Vec<Placement>), Error> {
+    let rect = |w: Lattice, h: Lattice| -> Vec<(Lattice, Lattice)> {
         (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).collect()
     };
     let none = || Error::Request(format!("no root patch found for the {}", system.name()));
@@ -460,15 +461,15 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
     let mut owner: HashMap<(i64, i64), usize> = HashMap::new();
     for (i, t) in tiles.iter().enumerate() {
         for (x, y) in t.placement.cells(&lut.shape) {
-            owner.insert((x as i64, y as i64), i);
+            owner.insert((x, y), i);
         }
     }
     // (class, the neighbours' origins and orientations in the tile's frame)
-    type Neighbourhood = (u32, Vec<(i32, i32, usize)>);
+    type Neighbourhood = (u32, Vec<(Lattice, Lattice, usize)>);
     let mut counts: HashMap<Neighbourhood, usize> = HashMap::new();
     for (i, t) in tiles.iter().enumerate() {
         let inverse = t.placement.orientation.inverse();
-        let mut signature: Vec<(i32, i32, usize)> = Vec::new();
+        let mut signature: Vec<(Lattice, Lattice, usize)> = Vec::new();
         for (x, y) in t.placement.cells(&lut.shape) {
             for (dx, dy) in [
                 (1, 0),
@@ -480,10 +481,7 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
                 (-1, 1),
                 (-1, -1),
             ] {
-                let cell = (
-                    (x as i64 + dx).rem_euclid(size),
-                    (y as i64 + dy).rem_euclid(size),
-                );
+                let cell = ((x + dx).rem_euclid(size), (y + dy).rem_euclid(size));
                 let j = owner[&cell];
                 if j == i {
                     continue;
@@ -494,8 +492,8 @@ fn neighbourhood_agreement(lut: &PlaneLut, level: u32) -> f64 {
                     o.origin.0 - t.placement.origin.0,
                     o.origin.1 - t.placement.origin.1,
                 );
-                rel.0 = (rel.0 as i64 + size / 2).rem_euclid(size) as i32 - (size / 2) as i32;
-                rel.1 = (rel.1 as i64 + size / 2).rem_euclid(size) as i32 - (size / 2) as i32;
+                rel.0 = (rel.0 + size / 2).rem_euclid(size) - size / 2;
+                rel.1 = (rel.1 + size / 2).rem_euclid(size) - size / 2;
                 let local = inverse.apply(rel);
                 let orient = o.orientation.then(inverse).index();
                 signature.push((local.0, local.1, orient));
@@ -547,30 +545,7 @@ fn relax(
     for _ in 0..options.iterations {
         let sites = sites_of(&tiles, &offsets, p);
         let grid = TorusGrid::new(&sites, p);
-        // nearest site of every quadrature point, rows in parallel; sums in
-        // row order so the result does not depend on the thread count
-        let rows: Vec<Vec<u32>> = (0..n)
-            .into_par_iter()
-            .map(|j| {
-                (0..n)
-                    .map(|i| {
-                        let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
-                        grid.nearest(qp, None).0 as u32
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut sum = vec![[0.0f64; 2]; sites.len()];
-        let mut count = vec![0usize; sites.len()];
-        for (j, row) in rows.iter().enumerate() {
-            for (i, &s) in row.iter().enumerate() {
-                let qp = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
-                let s = s as usize;
-                sum[s][0] += wrap_half(qp[0] - sites[s][0], p);
-                sum[s][1] += wrap_half(qp[1] - sites[s][1], p);
-                count[s] += 1;
-            }
-        }
+        let (sum, count) = cell_moments(&grid, n, h, [0.0, 0.0]);
         // each class moves by the mean of its sites' moves, in tile frames
         let mut class_sum = vec![[0.0f64; 2]; offsets.len()];
         let mut class_n = vec![0usize; offsets.len()];
@@ -672,102 +647,4 @@ fn separate(tiles: &[PlaneTile], offsets: &mut [[f64; 2]], p: f64, steps: usize)
         }
     }
     offsets.copy_from_slice(&best);
-}
-
-/// `v` reduced into `[-p/2, p/2)`.
-fn wrap_half(v: f64, p: f64) -> f64 {
-    v - p * (v / p + 0.5).floor()
-}
-
-fn torus_d2(a: [f64; 2], b: [f64; 2], p: f64) -> f64 {
-    let dx = wrap_half(a[0] - b[0], p);
-    let dy = wrap_half(a[1] - b[1], p);
-    dx * dx + dy * dy
-}
-
-/// Nearest-point queries on the torus `[0, p)^2` by bucketing into a grid
-/// of about one point per bucket.
-struct TorusGrid<'a> {
-    points: &'a [[f64; 2]],
-    period: f64,
-    n: usize,
-    start: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl<'a> TorusGrid<'a> {
-    fn new(points: &'a [[f64; 2]], period: f64) -> Self {
-        let n = ((points.len() as f64).sqrt() as usize).max(1);
-        let bucket = |q: [f64; 2]| -> usize {
-            let f = |v: f64| (((v.rem_euclid(period)) / period * n as f64) as usize).min(n - 1);
-            f(q[1]) * n + f(q[0])
-        };
-        let mut start = vec![0u32; n * n + 1];
-        for &q in points {
-            start[bucket(q) + 1] += 1;
-        }
-        for k in 0..n * n {
-            start[k + 1] += start[k];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; points.len()];
-        for (i, &q) in points.iter().enumerate() {
-            let b = bucket(q);
-            items[fill[b] as usize] = i as u32;
-            fill[b] += 1;
-        }
-        TorusGrid {
-            points,
-            period,
-            n,
-            start,
-            items,
-        }
-    }
-
-    /// Index and squared distance of the nearest point other than `exclude`.
-    fn nearest(&self, q: [f64; 2], exclude: Option<usize>) -> (usize, f64) {
-        let n = self.n as i64;
-        let cell = self.period / self.n as f64;
-        let at = |v: f64| ((v.rem_euclid(self.period) / cell) as i64).min(n - 1);
-        let (cx, cy) = (at(q[0]), at(q[1]));
-        let mut best = (usize::MAX, f64::INFINITY);
-        let visit = |bx: i64, by: i64, best: &mut (usize, f64)| {
-            let b = (by.rem_euclid(n) * n + bx.rem_euclid(n)) as usize;
-            for &i in &self.items[self.start[b] as usize..self.start[b + 1] as usize] {
-                let i = i as usize;
-                if Some(i) == exclude {
-                    continue;
-                }
-                let d = torus_d2(q, self.points[i], self.period);
-                if d < best.1 || (d == best.1 && i < best.0) {
-                    *best = (i, d);
-                }
-            }
-        };
-        let mut r = 0i64;
-        loop {
-            if 2 * r + 1 >= n {
-                // the ring wraps onto itself: scan everything
-                for by in 0..n {
-                    for bx in 0..n {
-                        visit(bx, by, &mut best);
-                    }
-                }
-                return best;
-            }
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx.abs() == r || dy.abs() == r {
-                        visit(cx + dx, cy + dy, &mut best);
-                    }
-                }
-            }
-            // anything outside rings 0..=r is at least r cells away
-            if best.1 <= (r as f64 * cell).powi(2) {
-                return best;
-            }
-            r += 1;
-        }
-    }
 }

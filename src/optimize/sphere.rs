@@ -19,9 +19,9 @@ use super::exact_cover;
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
 use crate::lut::{SphereLut, SPHERE_LUT_VERSION};
-use crate::tiling::polyomino::{Orientation, Placement, Rule, Shape};
+use crate::tiling::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
 use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
-use crate::tiling::TileSystem;
+use crate::tiling::{Code, TileSystem};
 use crate::Error;
 use glam::DVec3;
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
@@ -208,7 +208,7 @@ fn choose_patch(
     options: &BuildOptions,
     progress: Progress,
 ) -> (Vec<Placement>, f64) {
-    let region: Vec<(i32, i32)> = (0..PATCH_SIDE)
+    let region: Vec<(Lattice, Lattice)> = (0..PATCH_SIDE)
         .flat_map(|y| (0..PATCH_SIDE).map(move |x| (x, y)))
         .collect();
     let total = options.patch_candidates.max(1);
@@ -491,8 +491,7 @@ impl CellMap {
         let mut owner = vec![u32::MAX; 12 * (nside * nside) as usize];
         for (t, tile) in tiles.iter().enumerate() {
             for (k, (i, j)) in tile.placement.cells(tiling.shape()).enumerate() {
-                let at = tile.face as usize * (nside * nside) as usize
-                    + (j as i64 * nside + i as i64) as usize;
+                let at = tile.face as usize * (nside * nside) as usize + (j * nside + i) as usize;
                 owner[at] = t as u32 * 8 + k as u32;
             }
         }
@@ -506,9 +505,9 @@ impl CellMap {
     }
 }
 
-const LOCAL_DIRS: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
+const LOCAL_DIRS: [(Lattice, Lattice); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
 
-fn dir_of(v: (i32, i32)) -> Dir {
+fn dir_of(v: (Lattice, Lattice)) -> Dir {
     match v {
         (1, 0) => Dir::PlusX,
         (0, 1) => Dir::PlusY,
@@ -517,7 +516,7 @@ fn dir_of(v: (i32, i32)) -> Dir {
     }
 }
 
-fn vec_of(d: Dir) -> (i32, i32) {
+fn vec_of(d: Dir) -> (Lattice, Lattice) {
     LOCAL_DIRS[d.index() as usize]
 }
 
@@ -550,10 +549,10 @@ fn window(
     tiling: &SphereTiling,
     tile: &SphereTile,
     radius: u32,
-) -> Vec<(Cell, (i32, i32), Orientation)> {
+) -> Vec<(Cell, (Lattice, Lattice), Orientation)> {
     let face_to_local = tile.placement.orientation.inverse();
     let nside = SphereTiling::nside(tile.level as u32);
-    let mut seen: Vec<(Cell, (i32, i32), Orientation, u32)> = tile
+    let mut seen: Vec<(Cell, (Lattice, Lattice), Orientation, u32)> = tile
         .placement
         .cells(tiling.shape())
         .zip(tiling.shape().cells())
@@ -561,8 +560,8 @@ fn window(
             (
                 Cell {
                     face: tile.face,
-                    i: i as i64,
-                    j: j as i64,
+                    i,
+                    j,
                 },
                 (2 * u + 1, 2 * v + 1),
                 face_to_local,
@@ -609,7 +608,7 @@ fn signature(
 ) -> Vec<(i16, i16, u32)> {
     let tile = &tiles[t];
     let nside = SphereTiling::nside(tile.level as u32);
-    let digit_weight = (ROOT_COUNT as u64) << (2 * (tile.level.max(1) as u32 - 1));
+    let digit_weight = (ROOT_COUNT as Code) << (2 * (tile.level.max(1) as u32 - 1));
     let mut signature: Vec<(i16, i16, u32)> = window(tiling, tile, radius)
         .into_iter()
         .map(|(cell, centre, frame)| {
@@ -683,8 +682,8 @@ fn local_owner(tiling: &SphereTiling, tiles: &[SphereTile]) -> HashMap<Cell, (us
             map.insert(
                 Cell {
                     face: tile.face,
-                    i: i as i64,
-                    j: j as i64,
+                    i,
+                    j,
                 },
                 (t, k),
             );

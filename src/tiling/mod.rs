@@ -4,28 +4,60 @@
 //! indices and offset tables; it knows nothing of densities or file formats.
 //! [`crate::engine`] drives any [`TileSystem`].
 
+pub mod penrose;
 pub mod plane;
 pub mod polyomino;
 pub mod reference;
 pub mod sphere;
 
-/// A tile's threshold code (see [`TileSystem`]). Wide enough for the
-/// deepest level of every system; compare it with densities through `as f64`.
+use crate::engine::Sample;
+
+/// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
+/// every system's deepest level (the sphere's level 36 has `240 * 4^36`
+/// tiles, more than `u64` counts); compare codes with densities through
+/// [`code_value`].
 ///
 /// # Example
 /// ```
 /// let code: tessera::tiling::Code = 7;
-/// assert_eq!(code as f64 + 0.5, 7.5);
+/// assert_eq!(tessera::tiling::code_value(code) + 0.5, 7.5);
 /// ```
-pub type Code = u64;
+pub type Code = u128;
+
+/// `code` as an f64. Codes below 2^64 (every sphere level to 28) take one
+/// instruction; a plain `as f64` of a u128 is a library call, which the
+/// engine would pay at every tile.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::code_value;
+/// assert_eq!(code_value(3), 3.0);
+/// assert_eq!(code_value(1 << 100), 2f64.powi(100));
+/// ```
+#[inline(always)]
+pub fn code_value(code: Code) -> f64 {
+    // the wide conversion sits out of line so that the compiler does not
+    // compute it speculatively next to the fast one
+    #[cold]
+    #[inline(never)]
+    fn wide(code: Code) -> f64 {
+        code as f64
+    }
+    match u64::try_from(code) {
+        Ok(small) => small as f64,
+        Err(_) => wide(code),
+    }
+}
 
 /// A self-similar tiling with codes and offset tables, as the engine sees it.
 ///
 /// Codes: every tile at `level` has a code in `0..capacity(level)`; over the
-/// whole domain the codes of one level are a permutation of that range, and a
-/// child's code extends its parent's with a new most significant digit. A
-/// terminal tile is accepted when `code < d`, `d` being the requested density
-/// in samples per domain, so thresholds keep well-spread subsets.
+/// whole domain the codes of one level are a permutation of that range (or,
+/// for Penrose's Fibonacci codes, spread evenly over it: see
+/// [`TileSystem::codes_per_sample`]), and a child's code extends its
+/// parent's with a new most significant digit. A terminal tile is accepted
+/// when `code < d`, `d` being the requested density in samples per domain
+/// (times `codes_per_sample`), so thresholds keep well-spread subsets.
 ///
 /// # Example
 /// ```
@@ -88,8 +120,72 @@ pub trait TileSystem: Sync {
             .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
             .collect()
     }
+    /// The samples of the tiles of `level` with codes `0..count` (what a
+    /// constant density of `d` samples per domain accepts: density
+    /// `fraction` of the level's capacity), ranked `code / d`, in code
+    /// order; `None` as for [`TileSystem::map_code_order`]. The default
+    /// samples every tile that method yields; systems override it to place
+    /// points without building whole tiles.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let s = sphere.code_order_samples(1, 500, 500.0 / 960.0, 500.0).unwrap();
+    /// assert_eq!(s.len(), 500);
+    /// assert_eq!(s[10].rank, 10.0 / 500.0);
+    /// ```
+    fn code_order_samples(
+        &self,
+        level: u32,
+        count: usize,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Vec<Sample<Self::Point>>> {
+        self.map_code_order(level, count, &|code, tile| Sample {
+            position: self.sample(tile, fraction),
+            rank: code_value(code) / d,
+        })
+    }
+    /// Whether a terminal tile carries a sample. Penrose triangles only
+    /// subdivide: its point tiles carry the samples.
+    fn carries_sample(&self, tile: &Self::Tile) -> bool {
+        let _ = tile;
+        true
+    }
+    /// Code units per expected sample: over the domain, about
+    /// `c / codes_per_sample()` sampling tiles of a level have codes below
+    /// `c`. 1 when codes are a permutation of `0..capacity` (systems that
+    /// find tiles from codes must keep it 1); the engine scales requests by
+    /// it.
+    fn codes_per_sample(&self) -> f64 {
+        1.0
+    }
+    /// The sample of an accepted tile as the recursion places it: `None`
+    /// when it falls outside the domain (a tiling that extends beyond its
+    /// domain keeps only the samples inside, so spacing holds at the
+    /// border). Defaults to [`TileSystem::sample`].
+    fn sample_in_domain(&self, tile: &Self::Tile, fraction: f64) -> Option<Self::Point> {
+        Some(self.sample(tile, fraction))
+    }
     /// The sample position of an accepted tile, when the local density is
     /// `fraction * capacity(level)` (fraction in `(0, 1]`): reference point
     /// plus the table offset in the tile's basis.
     fn sample(&self, tile: &Self::Tile, fraction: f64) -> Self::Point;
+}
+
+/// `v` mirrored into `[0, 1)` at the unit square's edges (points an offset
+/// carries just outside re-enter).
+#[inline]
+pub(crate) fn mirror_unit(v: f64) -> f64 {
+    let w = if v < 0.0 {
+        -v
+    } else if v >= 1.0 {
+        2.0 - v
+    } else {
+        return v;
+    };
+    // offsets move points less than a root tile, so one mirror suffices;
+    // the largest f64 below 1 keeps the half-open square
+    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }

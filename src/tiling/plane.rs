@@ -13,9 +13,10 @@
 //! periodically), so a point pushed across the square's border re-enters on
 //! the opposite side: every point lies in `[0, 1)^2`.
 
+use crate::engine::Sample;
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
-use crate::tiling::polyomino::{Placement, Shape};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
+use crate::tiling::{code_value, mirror_unit, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -98,16 +99,18 @@ impl PlaneRegion {
 pub struct PlaneTiling {
     lut: Arc<PlaneLut>,
     arity: usize,
-    scale: i32,
+    scale: Lattice,
     bins: usize,
     max_level: u32,
     roots_by_code: Vec<PlaneTile>,
-    /// `children[rule * A + child]`.
-    children: Vec<Placement>,
+    /// `steps[(rule * A + child) * 8 + parent orientation]`: the child's
+    /// placement in a parent at the origin so oriented, on the refined
+    /// lattice.
+    steps: Vec<Placement>,
     /// `child_rule[rule * A + child]`.
     child_rule: Vec<u8>,
-    /// `child_digit[rule * A + child]`, as a `u64`.
-    child_digit: Vec<u64>,
+    /// `child_digit[rule * A + child]`, as a [`Code`].
+    child_digit: Vec<Code>,
     /// `child_of_digit[rule * A + digit]`.
     child_of_digit: Vec<u8>,
     /// Decoded offsets, `class * bins + bin`.
@@ -115,9 +118,36 @@ pub struct PlaneTiling {
     /// The density fraction each bin was optimised for, increasing.
     bin_fractions: Vec<f64>,
     /// Roots times `A^level`: the weight of a level's new digit.
-    digit_weight: Vec<u64>,
+    digit_weight: Vec<Code>,
     /// `1 / (side * scale^level)`: lattice to unit square.
     inv_size: Vec<f64>,
+    /// The shape's cells and bounding box in each of the 8 orientations.
+    frames: [Frame; 8],
+}
+
+/// A rep-tile's cells (lower-left corners) and the corners of its bounding
+/// box, relative to a placement's origin, in one orientation.
+#[derive(Clone, Debug, Default)]
+struct Frame {
+    cells: Vec<(Lattice, Lattice)>,
+    lo: (Lattice, Lattice),
+    hi: (Lattice, Lattice),
+}
+
+impl Frame {
+    fn new(shape: &Shape, orientation: Orientation) -> Self {
+        let cells: Vec<_> = Placement::new((0, 0), orientation).cells(shape).collect();
+        let corner = |pick: fn(Lattice, Lattice) -> Lattice, far: Lattice| {
+            let x = cells.iter().map(|c| c.0).reduce(pick).unwrap_or(0);
+            let y = cells.iter().map(|c| c.1).reduce(pick).unwrap_or(0);
+            (x + far, y + far)
+        };
+        Frame {
+            lo: corner(Lattice::min, 0),
+            hi: corner(Lattice::max, 1),
+            cells,
+        }
+    }
 }
 
 impl PlaneTiling {
@@ -132,27 +162,29 @@ impl PlaneTiling {
     pub fn new(lut: Arc<PlaneLut>) -> Self {
         let arity = lut.arity();
         let scale = lut.rules[0].scale;
-        let roots = lut.roots.len() as u64;
-        // deepest level whose codes fit u64 and lattice coordinates i32
-        let mut max_level = 0u32;
-        loop {
-            let next = max_level + 1;
-            let codes = (roots as u128) * (arity as u128).pow(next);
-            let size = lut.side as i128 * (scale as i128).pow(next) + 4 * scale as i128;
-            if codes > u64::MAX as u128 || size > i32::MAX as i128 {
-                break;
-            }
-            max_level = next;
-        }
+        let roots = lut.roots.len() as Code;
+        let max_level = deepest_level(lut.side, scale, roots, arity as Code);
         let digit_weight = (0..=max_level)
-            .map(|l| roots * (arity as u64).pow(l))
+            .map(|l| roots * (arity as Code).pow(l))
             .collect();
         let inv_size = (0..=max_level)
             .map(|l| 1.0 / (lut.side as f64 * (scale as f64).powi(l as i32)))
             .collect();
-        let children = lut.rules.iter().flat_map(|r| r.children.clone()).collect();
+        let steps = lut
+            .rules
+            .iter()
+            .flat_map(|r| &r.children)
+            .flat_map(|child| {
+                Orientation::ALL.map(|o| Placement::new((0, 0), o).child(child, scale))
+            })
+            .collect();
         let child_rule = lut.child_rule.concat();
-        let child_digit: Vec<u64> = lut.child_digit.concat().iter().map(|&d| d as u64).collect();
+        let child_digit: Vec<Code> = lut
+            .child_digit
+            .concat()
+            .iter()
+            .map(|&d| d as Code)
+            .collect();
         let mut child_of_digit = vec![0u8; child_digit.len()];
         for (at, &d) in child_digit.iter().enumerate() {
             let rule = at / arity;
@@ -170,7 +202,7 @@ impl PlaneTiling {
                 level: 0,
                 rule: lut.root_rule[r],
                 class: lut.root_class[r],
-                code: lut.root_rank[r] as u64,
+                code: lut.root_rank[r] as Code,
             })
             .collect();
         roots_by_code.sort_by_key(|t| t.code);
@@ -180,7 +212,7 @@ impl PlaneTiling {
             bins: lut.bins as usize,
             max_level,
             roots_by_code,
-            children,
+            steps,
             child_rule,
             child_digit,
             child_of_digit,
@@ -188,6 +220,7 @@ impl PlaneTiling {
             bin_fractions,
             digit_weight,
             inv_size,
+            frames: Orientation::ALL.map(|o| Frame::new(&lut.shape, o)),
             lut,
         }
     }
@@ -251,12 +284,20 @@ impl PlaneTiling {
     #[inline]
     fn subdivide(&self, tile: &PlaneTile, child: usize) -> PlaneTile {
         let at = tile.rule as usize * self.arity + child;
+        let code = tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize];
+        self.child_coded(tile, child, code)
+    }
+
+    /// Child `child` of `tile`, whose code the caller already knows.
+    #[inline(always)]
+    fn child_coded(&self, tile: &PlaneTile, child: usize, code: Code) -> PlaneTile {
+        let at = tile.rule as usize * self.arity + child;
         PlaneTile {
-            placement: tile.placement.child(&self.children[at], self.scale),
+            placement: self.child_placement(&tile.placement, at),
             level: tile.level + 1,
             rule: self.child_rule[at],
             class: self.lut.transitions[tile.class as usize * self.arity + child],
-            code: tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize],
+            code,
         }
     }
 
@@ -293,7 +334,7 @@ impl PlaneTiling {
             level: 0,
             rule: lut.root_rule[r],
             class: lut.root_class[r],
-            code: lut.root_rank[r] as u64,
+            code: lut.root_rank[r] as Code,
         }
     }
 
@@ -334,29 +375,32 @@ impl PlaneTiling {
 
     #[inline]
     fn position(&self, tile: &PlaneTile, bin: usize) -> DVec2 {
-        let [ox, oy] = self.offsets[tile.class as usize * self.bins + bin];
-        let m = tile.placement.orientation.matrix();
-        let (x0, y0) = tile.placement.origin;
-        let x = x0 as f64 + m[0][0] as f64 * ox + m[0][1] as f64 * oy;
-        let y = y0 as f64 + m[1][0] as f64 * ox + m[1][1] as f64 * oy;
         let s = self.inv_size[tile.level as usize];
-        DVec2::new(wrap(x * s), wrap(y * s))
+        self.place(&tile.placement, tile.class, bin, s)
     }
-}
 
-/// `v` mirrored into `[0, 1)` at the square's edges.
-#[inline]
-fn wrap(v: f64) -> f64 {
-    let w = if v < 0.0 {
-        -v
-    } else if v >= 1.0 {
-        2.0 - v
-    } else {
-        return v;
-    };
-    // offsets move points less than a root tile, so one mirror suffices;
-    // the largest f64 below 1 keeps the half-open square
-    w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
+    /// The point of a tile so placed, of structural index `class`, in
+    /// importance bin `bin`, on a lattice of `1 / s` cells per unit.
+    #[inline(always)]
+    fn place(&self, placement: &Placement, class: u32, bin: usize, s: f64) -> DVec2 {
+        let [x, y] = placement.to_lattice(self.offsets[class as usize * self.bins + bin]);
+        DVec2::new(mirror_unit(x * s), mirror_unit(y * s))
+    }
+
+    /// The placement of child `at` (`rule * A + child`) of a tile so placed:
+    /// [`Placement::child`] from a table of the child's step for each of
+    /// the parent's 8 orientations.
+    #[inline(always)]
+    fn child_placement(&self, parent: &Placement, at: usize) -> Placement {
+        let step = &self.steps[at * 8 + parent.orientation.index()];
+        Placement {
+            origin: (
+                self.scale * parent.origin.0 + step.origin.0,
+                self.scale * parent.origin.1 + step.origin.1,
+            ),
+            orientation: step.orientation,
+        }
+    }
 }
 
 impl TileSystem for PlaneTiling {
@@ -385,7 +429,10 @@ impl TileSystem for PlaneTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        self.lut.roots.len() as f64 * (self.arity as f64).powi(level as i32)
+        match self.digit_weight.get(level as usize) {
+            Some(&tiles) => code_value(tiles),
+            None => self.lut.roots.len() as f64 * (self.arity as f64).powi(level as i32),
+        }
     }
 
     fn measure(&self) -> f64 {
@@ -398,21 +445,20 @@ impl TileSystem for PlaneTiling {
 
     fn region(&self, tile: &PlaneTile) -> PlaneRegion {
         let s = self.inv_size[tile.level as usize];
-        let mut region = PlaneRegion {
-            lo: DVec2::INFINITY,
-            hi: DVec2::NEG_INFINITY,
-            cell: s,
-            cells: [DVec2::ZERO; MAX_CELLS],
-            count: 0,
-        };
-        for (k, (x, y)) in tile.placement.cells(&self.lut.shape).enumerate() {
-            let corner = DVec2::new(x as f64, y as f64) * s;
-            region.lo = region.lo.min(corner);
-            region.hi = region.hi.max(corner + s);
-            region.cells[k] = corner + 0.5 * s;
-            region.count += 1;
+        let (x0, y0) = tile.placement.origin;
+        let at = |(dx, dy): (Lattice, Lattice)| DVec2::new((x0 + dx) as f64, (y0 + dy) as f64) * s;
+        let frame = &self.frames[tile.placement.orientation.index()];
+        let mut cells = [DVec2::ZERO; MAX_CELLS];
+        for (cell, &offset) in cells.iter_mut().zip(&frame.cells) {
+            *cell = at(offset) + 0.5 * s;
         }
-        region
+        PlaneRegion {
+            lo: at(frame.lo),
+            hi: at(frame.hi),
+            cell: s,
+            cells,
+            count: frame.cells.len() as u8,
+        }
     }
 
     fn map_code_order<T: Send>(
@@ -426,7 +472,7 @@ impl TileSystem for PlaneTiling {
         }
         if level == 0 {
             let roots = self.roots_by_code[..count].iter().enumerate();
-            return Some(roots.map(|(code, t)| f(code as u64, t)).collect());
+            return Some(roots.map(|(code, t)| f(code as Code, t)).collect());
         }
         // codes `digit * m + c` share their parent with code `c` one level
         // up: find the parents once, then every digit block from them
@@ -439,10 +485,78 @@ impl TileSystem for PlaneTiling {
                 break;
             }
             let block = parents[..(count - start).min(m)].par_iter().enumerate();
-            out.par_extend(
-                block.map(|(c, p)| f((start + c) as u64, &self.child_with_digit(p, digit))),
-            );
+            out.par_extend(block.with_min_len(1024).map(|(c, p)| {
+                // the child carrying `digit` has code `start + c`
+                let code = (start + c) as Code;
+                let child = self.child_of_digit[p.rule as usize * self.arity + digit];
+                f(code, &self.child_coded(p, child as usize, code))
+            }));
         }
+        Some(out)
+    }
+
+    /// Places each point straight from its grandparent: the parents are
+    /// found on the fly and no tile is built for them or the points. Code
+    /// `d * m1 + e * m2 + k` (digits `d`, `e`; `m1`, `m2` the parent and
+    /// grandparent levels' tile counts) is child `d` of child `e` of
+    /// grandparent `k`, so each `(d, e)` is a run of `k` in the output,
+    /// written in order.
+    fn code_order_samples(
+        &self,
+        level: u32,
+        count: usize,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Vec<Sample<DVec2>>> {
+        if level < 2 || level > self.max_level || count as f64 > self.capacity(level) {
+            return self.map_code_order(level, count, &|code, tile| Sample {
+                position: self.sample(tile, fraction),
+                rank: code_value(code) / d,
+            });
+        }
+        let (bin, s, a) = (
+            self.bin(fraction),
+            self.inv_size[level as usize],
+            self.arity,
+        );
+        let m1 = self.digit_weight[level as usize - 1] as usize;
+        let m2 = self.digit_weight[level as usize - 2] as usize;
+        let grandparents = self.map_code_order(level - 2, count.min(m2), &|_, t| {
+            (t.placement, t.rule, t.class)
+        })?;
+        let unset = Sample {
+            position: DVec2::ZERO,
+            rank: 0.0,
+        };
+        let mut out = vec![unset; count];
+        // runs[e]: the output runs of the parents of digit `e`, one per `d`
+        let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
+        for (q, run) in out.chunks_mut(m2).enumerate() {
+            runs[q % a].push((q / a, run));
+        }
+        runs.into_par_iter().enumerate().for_each(|(e, mut runs)| {
+            let longest = runs.iter().map(|(_, run)| run.len()).max().unwrap_or(0);
+            for (k, (placement, rule, class)) in grandparents[..longest].iter().enumerate() {
+                // the parent: child of digit `e`
+                let child = self.child_of_digit[*rule as usize * a + e] as usize;
+                let at = *rule as usize * a + child;
+                let parent = self.child_placement(placement, at);
+                let (rule, class) = (
+                    self.child_rule[at] as usize,
+                    self.lut.transitions[*class as usize * a + child] as usize,
+                );
+                for (digit, run) in runs.iter_mut() {
+                    let Some(slot) = run.get_mut(k) else { continue };
+                    let child = self.child_of_digit[rule * a + *digit] as usize;
+                    let placement = self.child_placement(&parent, rule * a + child);
+                    let class = self.lut.transitions[class * a + child];
+                    *slot = Sample {
+                        position: self.place(&placement, class, bin, s),
+                        rank: (*digit * m1 + e * m2 + k) as f64 / d,
+                    };
+                }
+            }
+        });
         Some(out)
     }
 
@@ -450,13 +564,13 @@ impl TileSystem for PlaneTiling {
         if level > self.max_level || code >= self.digit_weight[level as usize] {
             return None;
         }
-        let roots = self.roots_by_code.len() as u64;
+        let roots = self.roots_by_code.len() as Code;
         let mut tile = self.roots_by_code[(code % roots) as usize];
         let mut digits = code / roots;
         for _ in 0..level {
-            let digit = (digits % self.arity as u64) as usize;
+            let digit = (digits % self.arity as Code) as usize;
             tile = self.child_with_digit(&tile, digit);
-            digits /= self.arity as u64;
+            digits /= self.arity as Code;
         }
         Some(tile)
     }
@@ -466,9 +580,40 @@ impl TileSystem for PlaneTiling {
     }
 }
 
+/// Lattice cells per unit-square edge beyond which f64 positions lose
+/// resolution: `2^40` keeps a cell thousands of ulps wide.
+pub const MAX_LATTICE_SIDE: Lattice = 1 << 40;
+
+/// The deepest level of a `side`-cell root patch refined by `scale` per
+/// level whose codes (`roots * arity^level`) fit [`Code`] and whose lattice
+/// (`side * scale^level`, plus a child's reach) stays within
+/// [`MAX_LATTICE_SIDE`].
+///
+/// # Example
+/// ```
+/// use tessera::tiling::plane::deepest_level;
+/// // P-pentomino: 10 cells, doubling per level: 10 * 2^36 < 2^40 < 10 * 2^37
+/// assert_eq!(deepest_level(10, 2, 20, 4), 36);
+/// ```
+pub fn deepest_level(side: Lattice, scale: Lattice, roots: Code, arity: Code) -> u32 {
+    let mut level = 0u32;
+    loop {
+        let next = level + 1;
+        let codes = arity.checked_pow(next).and_then(|a| a.checked_mul(roots));
+        let size = scale
+            .checked_pow(next)
+            .and_then(|s| s.checked_mul(side))
+            .and_then(|s| s.checked_add(4 * scale));
+        match (codes, size) {
+            (Some(_), Some(size)) if size <= MAX_LATTICE_SIDE => level = next,
+            _ => return level,
+        }
+    }
+}
+
 impl super::reference::ReferencePoint for PlaneTiling {
     fn reference(&self, tile: &PlaneTile) -> DVec2 {
         let p = self.to_unit(tile, self.lut.shape.centroid());
-        DVec2::new(wrap(p.x), wrap(p.y))
+        DVec2::new(mirror_unit(p.x), mirror_unit(p.y))
     }
 }

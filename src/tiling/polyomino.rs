@@ -7,6 +7,16 @@
 
 use serde::{Deserialize, Serialize};
 
+/// A lattice coordinate. 64 bits keep deep levels exact: the sphere's
+/// lattice at level `k` has `10 * 2^k` cells per face edge.
+///
+/// # Example
+/// ```
+/// let side: tessera::tiling::polyomino::Lattice = 10 << 40;
+/// assert!(side > i32::MAX as i64);
+/// ```
+pub type Lattice = i64;
+
 /// One of the 8 symmetries of the square lattice: `r` quarter turns
 /// counter-clockwise applied after an optional mirror `x -> -x`.
 ///
@@ -109,7 +119,7 @@ impl Orientation {
     /// use tessera::tiling::polyomino::Orientation;
     /// assert_eq!(Orientation::IDENTITY.matrix(), [[1, 0], [0, 1]]);
     /// ```
-    pub fn matrix(self) -> [[i32; 2]; 2] {
+    pub fn matrix(self) -> [[Lattice; 2]; 2] {
         MATRICES[self.0 as usize]
     }
 
@@ -120,7 +130,7 @@ impl Orientation {
     /// use tessera::tiling::polyomino::Orientation;
     /// assert_eq!(Orientation::new(0, true).apply((1, 1)), (-1, 1));
     /// ```
-    pub fn apply(self, v: (i32, i32)) -> (i32, i32) {
+    pub fn apply(self, v: (Lattice, Lattice)) -> (Lattice, Lattice) {
         let m = self.matrix();
         (m[0][0] * v.0 + m[0][1] * v.1, m[1][0] * v.0 + m[1][1] * v.1)
     }
@@ -132,11 +142,12 @@ impl Orientation {
     /// use tessera::tiling::polyomino::Orientation;
     /// assert_eq!(Orientation::new(1, false).apply_f64([0.5, 0.0]), [0.0, 0.5]);
     /// ```
+    #[inline]
     pub fn apply_f64(self, v: [f64; 2]) -> [f64; 2] {
-        let m = self.matrix();
+        let m = &MATRICES_F64[self.0 as usize];
         [
-            m[0][0] as f64 * v[0] + m[0][1] as f64 * v[1],
-            m[1][0] as f64 * v[0] + m[1][1] as f64 * v[1],
+            m[0][0] * v[0] + m[0][1] * v[1],
+            m[1][0] * v[0] + m[1][1] * v[1],
         ]
     }
 
@@ -166,7 +177,7 @@ impl Orientation {
 }
 
 /// `rotation(turns) * diag(mirror, 1)` for every orientation index.
-const MATRICES: [[[i32; 2]; 2]; 8] = {
+const MATRICES: [[[Lattice; 2]; 2]; 8] = {
     let mut out = [[[0; 2]; 2]; 8];
     let mut k = 0;
     while k < 8 {
@@ -178,6 +189,21 @@ const MATRICES: [[[i32; 2]; 2]; 8] = {
             _ => (0, -1),
         };
         out[k] = [[c * mirror, -s], [s * mirror, c]];
+        k += 1;
+    }
+    out
+};
+
+/// [`MATRICES`] in f64, for placing points without conversions.
+const MATRICES_F64: [[[f64; 2]; 2]; 8] = {
+    let mut out = [[[0.0; 2]; 2]; 8];
+    let mut k = 0;
+    while k < 8 {
+        let m = MATRICES[k];
+        out[k] = [
+            [m[0][0] as f64, m[0][1] as f64],
+            [m[1][0] as f64, m[1][1] as f64],
+        ];
         k += 1;
     }
     out
@@ -248,7 +274,7 @@ const INVERSE: [u8; 8] = {
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shape {
-    cells: Vec<(i32, i32)>,
+    cells: Vec<(Lattice, Lattice)>,
 }
 
 impl Shape {
@@ -259,7 +285,7 @@ impl Shape {
     /// use tessera::tiling::polyomino::Shape;
     /// assert_eq!(Shape::new(vec![(0, 0), (1, 0)]).cells().len(), 2);
     /// ```
-    pub fn new(cells: Vec<(i32, i32)>) -> Self {
+    pub fn new(cells: Vec<(Lattice, Lattice)>) -> Self {
         Shape { cells }
     }
 
@@ -293,7 +319,7 @@ impl Shape {
     /// use tessera::tiling::polyomino::Shape;
     /// assert_eq!(Shape::p_pentomino().cells()[0], (0, 0));
     /// ```
-    pub fn cells(&self) -> &[(i32, i32)] {
+    pub fn cells(&self) -> &[(Lattice, Lattice)] {
         &self.cells
     }
 
@@ -304,7 +330,7 @@ impl Shape {
     /// use tessera::tiling::polyomino::Shape;
     /// assert_eq!(Shape::g_hexomino().bounding_size(), (3, 3));
     /// ```
-    pub fn bounding_size(&self) -> (i32, i32) {
+    pub fn bounding_size(&self) -> (Lattice, Lattice) {
         let w = self.cells.iter().map(|c| c.0).max().unwrap_or(-1) + 1;
         let h = self.cells.iter().map(|c| c.1).max().unwrap_or(-1) + 1;
         (w, h)
@@ -317,7 +343,7 @@ impl Shape {
     /// use tessera::tiling::polyomino::Shape;
     /// assert_eq!(Shape::p_pentomino().scaled(2).cells().len(), 20);
     /// ```
-    pub fn scaled(&self, factor: i32) -> Shape {
+    pub fn scaled(&self, factor: Lattice) -> Shape {
         let mut cells = Vec::with_capacity(self.cells.len() * (factor * factor) as usize);
         for &(x, y) in &self.cells {
             for dy in 0..factor {
@@ -397,7 +423,7 @@ impl Shape {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Placement {
     /// Lattice point that the shape frame's origin maps to.
-    pub origin: (i32, i32),
+    pub origin: (Lattice, Lattice),
     /// Orientation of the copy.
     pub orientation: Orientation,
 }
@@ -410,7 +436,7 @@ impl Placement {
     /// use tessera::tiling::polyomino::{Orientation, Placement};
     /// assert_eq!(Placement::new((1, 2), Orientation::IDENTITY).origin, (1, 2));
     /// ```
-    pub fn new(origin: (i32, i32), orientation: Orientation) -> Self {
+    pub fn new(origin: (Lattice, Lattice), orientation: Orientation) -> Self {
         Placement {
             origin,
             orientation,
@@ -426,7 +452,7 @@ impl Placement {
     /// let cells: Vec<_> = p.cells(&Shape::new(vec![(0, 0)])).collect();
     /// assert_eq!(cells, vec![(-1, -1)]);
     /// ```
-    pub fn cells<'a>(&self, shape: &'a Shape) -> impl Iterator<Item = (i32, i32)> + 'a {
+    pub fn cells<'a>(&self, shape: &'a Shape) -> impl Iterator<Item = (Lattice, Lattice)> + 'a {
         let (origin, orientation) = (self.origin, self.orientation);
         shape
             .cells()
@@ -457,7 +483,7 @@ impl Placement {
     /// let child = parent.child(&Placement::new((1, 0), Orientation::IDENTITY), 2);
     /// assert_eq!(child.origin, (3, 2));
     /// ```
-    pub fn child(&self, child: &Placement, scale: i32) -> Placement {
+    pub fn child(&self, child: &Placement, scale: Lattice) -> Placement {
         let o = self.orientation.apply(child.origin);
         Placement {
             origin: (scale * self.origin.0 + o.0, scale * self.origin.1 + o.1),
@@ -467,7 +493,11 @@ impl Placement {
 }
 
 /// Lower-left corner of the image of cell `c` under `origin + orientation`.
-fn cell_image(origin: (i32, i32), orientation: Orientation, c: (i32, i32)) -> (i32, i32) {
+fn cell_image(
+    origin: (Lattice, Lattice),
+    orientation: Orientation,
+    c: (Lattice, Lattice),
+) -> (Lattice, Lattice) {
     let doubled = orientation.apply((2 * c.0 + 1, 2 * c.1 + 1));
     (
         origin.0 + (doubled.0 - 1) / 2,
@@ -489,7 +519,7 @@ fn cell_image(origin: (i32, i32), orientation: Orientation, c: (i32, i32)) -> (i
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Rule {
     /// Linear scale factor between parent and children.
-    pub scale: i32,
+    pub scale: Lattice,
     /// Child placements in the parent's refined frame.
     pub children: Vec<Placement>,
 }
@@ -506,8 +536,8 @@ impl Rule {
     /// }
     /// ```
     pub fn tiles_parent(&self, shape: &Shape) -> bool {
-        let mut target: Vec<(i32, i32)> = shape.scaled(self.scale).cells().to_vec();
-        let mut covered: Vec<(i32, i32)> = self
+        let mut target: Vec<(Lattice, Lattice)> = shape.scaled(self.scale).cells().to_vec();
+        let mut covered: Vec<(Lattice, Lattice)> = self
             .children
             .iter()
             .flat_map(|p| p.cells(shape).collect::<Vec<_>>())
@@ -527,7 +557,7 @@ impl Rule {
     /// let rules = Rule::dissections(&Shape::p_pentomino(), 2, usize::MAX);
     /// assert_eq!(rules.len(), 2);
     /// ```
-    pub fn dissections(shape: &Shape, scale: i32, limit: usize) -> Vec<Rule> {
+    pub fn dissections(shape: &Shape, scale: Lattice, limit: usize) -> Vec<Rule> {
         let region = shape.scaled(scale).cells().to_vec();
         let mut found = crate::optimize::exact_cover::tilings(shape, &region, limit, 0);
         for children in &mut found {
@@ -567,11 +597,11 @@ impl Shape {
     /// assert_eq!(Shape::new(vec![(0, 0)]).outline(), vec![(0, 0), (1, 0), (1, 1), (0, 1)]);
     /// assert_eq!(Shape::p_pentomino().outline().len(), 10);
     /// ```
-    pub fn outline(&self) -> Vec<(i32, i32)> {
+    pub fn outline(&self) -> Vec<(Lattice, Lattice)> {
         use std::collections::HashMap;
-        let has = |c: (i32, i32)| self.cells.contains(&c);
+        let has = |c: (Lattice, Lattice)| self.cells.contains(&c);
         // directed boundary edges with the shape on their left
-        let mut next: HashMap<(i32, i32), (i32, i32)> = HashMap::new();
+        let mut next: HashMap<(Lattice, Lattice), (Lattice, Lattice)> = HashMap::new();
         for &(x, y) in &self.cells {
             if !has((x, y - 1)) {
                 next.insert((x, y), (x + 1, y));
@@ -609,7 +639,7 @@ impl Shape {
     /// assert!(Shape::p_pentomino().dilated().contains([-0.5, 3.5]));
     /// ```
     pub fn dilated(&self) -> Shape {
-        let mut cells: Vec<(i32, i32)> = self
+        let mut cells: Vec<(Lattice, Lattice)> = self
             .cells
             .iter()
             .flat_map(|&(x, y)| {

@@ -14,21 +14,22 @@
 
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
-use crate::tiling::polyomino::{Placement, Shape};
-use crate::tiling::{Code, TileSystem};
+use crate::tiling::polyomino::{Lattice, Placement, Shape};
+use crate::tiling::{code_value, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
-pub const PATCH_SIDE: i32 = 10;
+pub const PATCH_SIDE: Lattice = 10;
 /// Pentominoes per face at level 0.
 pub const ROOTS_PER_FACE: usize = 20;
 /// Number of level-0 tiles on the sphere.
 pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
-/// Deepest supported level: lattice coordinates `10 * 2^k` stay in `i32` and
-/// codes `240 * 4^k` in `u64`; tiles are about 1.5e-9 rad across.
-pub const MAX_LEVEL: u32 = 26;
+/// Deepest supported level: a face edge has `10 * 2^k <= 2^40` cells, so a
+/// cell still spans thousands of f64 ulps of face coordinates, and codes
+/// `240 * 4^k` fit [`Code`]; tiles are about 3e-12 rad across.
+pub const MAX_LEVEL: u32 = 36;
 /// Upper bound of the geodesic length (radians) of a unit step in face
 /// coordinates, anywhere on any face (measured by `tests/sphere.rs`: 1.47).
 pub const FACE_LIPSCHITZ: f64 = 1.6;
@@ -72,8 +73,8 @@ pub struct SphereTile {
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct SphereRegion {
-    /// The tile's centroid on the sphere.
-    pub center: DVec3,
+    /// The tile's centroid, in face coordinates (see [`SphereRegion::center`]).
+    pub centroid: FacePoint,
     /// Angular radius (rad) of a cap around `center` containing the tile.
     pub radius: f64,
     /// Base face.
@@ -83,6 +84,20 @@ pub struct SphereRegion {
 }
 
 impl SphereRegion {
+    /// The tile's centroid on the sphere (computed on demand: densities
+    /// that work in face or pixel coordinates never pay its trigonometry).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let region = sphere.region(&sphere.roots()[0]);
+    /// assert!((region.center().length() - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn center(&self) -> DVec3 {
+        self.centroid.to_vec()
+    }
+
     /// The five cell centres as unit vectors (an equal-weight quadrature).
     ///
     /// # Example
@@ -172,7 +187,7 @@ impl SphereTiling {
     /// assert_eq!(SphereTiling::nside(2), 40);
     /// ```
     pub fn nside(level: u32) -> i64 {
-        (PATCH_SIDE as i64) << level
+        PATCH_SIDE << level
     }
 
     fn subdivide(&self, tile: &SphereTile, child: usize) -> SphereTile {
@@ -186,14 +201,14 @@ impl SphereTiling {
         } else {
             lut.transitions[tile.index as usize][child]
         };
-        let digit = lut.child_digit[rule][child] as u64;
+        let digit = lut.child_digit[rule][child] as Code;
         SphereTile {
             face: tile.face,
             level: tile.level + 1,
             rule: lut.child_rule[rule][child],
             placement: tile.placement.child(&lut.rules[rule].children[child], 2),
             index,
-            code: tile.code + digit * ((ROOT_COUNT as u64) << (2 * level)),
+            code: tile.code + digit * ((ROOT_COUNT as Code) << (2 * level)),
         }
     }
 
@@ -276,7 +291,7 @@ impl TileSystem for SphereTiling {
                 rule: lut.root_rule[r],
                 placement: lut.patch[r % ROOTS_PER_FACE],
                 index: r as u32,
-                code: lut.root_rank[r] as u64,
+                code: lut.root_rank[r] as Code,
             })
             .collect()
     }
@@ -302,12 +317,10 @@ impl TileSystem for SphereTiling {
     }
 
     fn capacity(&self, level: u32) -> f64 {
-        if level <= MAX_LEVEL {
-            // 240 * 4^26 < 2^60: exact in u64, and in f64 (a power of two times 15)
-            ((ROOT_COUNT as u64) << (2 * level)) as f64
-        } else {
-            ROOT_COUNT as f64 * 4f64.powi(level as i32)
-        }
+        // 240 * 4^level, exact (15 times a power of two): 4^level built
+        // from its exponent bits rather than by a `powi` call per tile
+        let four_to_level = f64::from_bits((1023 + 2 * level.min(500) as u64) << 52);
+        ROOT_COUNT as f64 * four_to_level
     }
 
     fn code(&self, tile: &SphereTile) -> Code {
@@ -315,8 +328,8 @@ impl TileSystem for SphereTiling {
     }
 
     fn child_code(&self, tile: &SphereTile, i: usize) -> Code {
-        let digit = self.lut.child_digit[tile.rule as usize][i] as u64;
-        tile.code + digit * ((ROOT_COUNT as u64) << (2 * tile.level as u32))
+        let digit = self.lut.child_digit[tile.rule as usize][i] as Code;
+        tile.code + digit * ((ROOT_COUNT as Code) << (2 * tile.level as u32))
     }
 
     fn region(&self, tile: &SphereTile) -> SphereRegion {
@@ -328,7 +341,7 @@ impl TileSystem for SphereTiling {
         };
         let nside = Self::nside(tile.level as u32) as f64;
         SphereRegion {
-            center: self.face_point(tile, centroid).to_vec(),
+            centroid: self.face_point(tile, centroid),
             radius: FACE_LIPSCHITZ * PENTOMINO_RADIUS / nside,
             face: tile.face,
             cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
@@ -346,7 +359,7 @@ impl TileSystem for SphereTiling {
         }
         if level == 0 {
             let roots = self.roots_by_code[..count].iter().enumerate();
-            return Some(roots.map(|(code, t)| f(code as u64, t)).collect());
+            return Some(roots.map(|(code, t)| f(code as Code, t)).collect());
         }
         // codes `digit * m + c` share their parent with code `c` one level
         // up: find the parents once, then every digit block from them
@@ -361,20 +374,20 @@ impl TileSystem for SphereTiling {
             let block = parents[..(count - start).min(m)].par_iter().enumerate();
             out.par_extend(block.map(|(c, p)| {
                 let child = self.child_of_digit[p.rule as usize][digit] as usize;
-                f((start + c) as u64, &self.subdivide(p, child))
+                f((start + c) as Code, &self.subdivide(p, child))
             }));
         }
         Some(out)
     }
 
     fn tile_with_code(&self, level: u32, code: Code) -> Option<SphereTile> {
-        if level > MAX_LEVEL || code as f64 >= self.capacity(level) {
+        if level > MAX_LEVEL || code_value(code) >= self.capacity(level) {
             return None;
         }
         let mut tile = *self
             .roots_by_code
-            .get((code % ROOT_COUNT as u64) as usize)?;
-        let mut digits = code / ROOT_COUNT as u64;
+            .get((code % ROOT_COUNT as Code) as usize)?;
+        let mut digits = code / ROOT_COUNT as Code;
         for _ in 0..level {
             let child = self.child_of_digit[tile.rule as usize][(digits & 3) as usize];
             tile = self.subdivide(&tile, child as usize);
