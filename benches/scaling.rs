@@ -26,6 +26,7 @@ use tessera::density::plane::Ramp;
 use tessera::density::sphere::Cap;
 use tessera::density::{Density, Region, Uniform};
 use tessera::engine;
+use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::PlaneTiling;
 use tessera::tiling::sphere::SphereTiling;
 use tessera::tiling::TileSystem;
@@ -145,7 +146,7 @@ fn sphere(c: &mut Criterion) {
     g.finish();
 }
 
-/// The planar systems; a new one (Penrose) is benchmarked by adding it here.
+/// The polyomino systems (Penrose, another tile type, is benchmarked beside them).
 fn plane_systems() -> [(&'static str, PlaneTiling); 2] {
     [
         ("ghexomino", PlaneTiling::ghexomino()),
@@ -176,6 +177,14 @@ fn raster(c: &mut Criterion) {
     for (name, tiling) in plane_systems() {
         tile_system(c, "plane/raster", name, &tiling, &image, sizes);
     }
+    tile_system(
+        c,
+        "plane/raster",
+        "penrose",
+        &PenroseTiling::default(),
+        &image,
+        sizes,
+    );
     let cdf = RasterCdf::new(&image).expect("a lit image");
     baseline(c, "plane/raster", "iid_inverse_cdf", sizes, |n| {
         uniform_random_2d(n, 1)
@@ -196,6 +205,16 @@ fn plane(c: &mut Criterion) {
         tile_system(c, "plane/uniform", name, &tiling, &Uniform, &IN_MEMORY);
         tile_system(c, "plane/ramp", name, &tiling, &Ramp, &IN_MEMORY[..2]);
     }
+    let penrose = PenroseTiling::default();
+    tile_system(
+        c,
+        "plane/uniform",
+        "penrose",
+        &penrose,
+        &Uniform,
+        &IN_MEMORY,
+    );
+    tile_system(c, "plane/ramp", "penrose", &penrose, &Ramp, &IN_MEMORY[..2]);
     raster(c);
     baseline(c, "plane/uniform", "iid", &IN_MEMORY, |n| {
         uniform_random_2d(n, 1)

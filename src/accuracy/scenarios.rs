@@ -1,6 +1,6 @@
 //! The compared samplers in each scenario. Tile systems enter through
 //! [`uniform_tile_methods`] (one line each; a new system such as Penrose
-//! tiles is added beside the polyomino systems in [`plane_uniform`]).
+//! tiles sit beside the polyomino systems in [`plane_uniform`]).
 //!
 //! Knobs of the tile samplers, each a method of its own:
 //! - default: offset tables on, f64 output, exact N, randomised;
@@ -21,6 +21,7 @@ use crate::baselines::{
 use crate::density::envmap::EnvMap;
 use crate::density::{Region, Uniform};
 use crate::engine;
+use crate::tiling::penrose::PenroseTiling;
 use crate::tiling::plane::PlaneTiling;
 use crate::tiling::reference::{ReferencePoint, WithoutOffsets};
 use crate::tiling::sphere::{SphereRegion, SphereTiling};
@@ -189,7 +190,12 @@ pub(super) fn plane_uniform<'a>() -> Scenario<'a, DVec2> {
         shift,
         to_f32,
     ));
-    // Penrose tiles (in progress elsewhere) join here the same way.
+    methods.extend(uniform_tile_methods(
+        "penrose",
+        PenroseTiling::default(),
+        shift,
+        to_f32,
+    ));
     methods.extend([
         method("i.i.d.", false, uniform_random_2d),
         method("sobol", false, sobol::owen_sobol_2d),
