@@ -5,8 +5,10 @@
 //!
 //! Groups: `sphere/uniform`, `sphere/cap` (adaptive), `sphere/stream` (10^8,
 //! one thread: about 20 s an iteration, so the group takes minutes),
-//! `plane/uniform`, `plane/ramp` (adaptive), `envmap/sky` (adaptive on the
-//! accuracy bench's generated sky; the hostile-map bench is `envmap.rs`).
+//! `plane/uniform`, `plane/ramp` and `plane/raster` (adaptive; the image
+//! against inverse-CDF warps of i.i.d. and Sobol points), `envmap/sky`
+//! (adaptive on the accuracy bench's generated sky; the hostile-map bench is
+//! `envmap.rs`).
 //! Run: `cargo bench --bench scaling`; medians are in
 //! `target/criterion/<group>/<function>/<N>/new/estimates.json`.
 
@@ -14,15 +16,17 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use glam::DVec3;
 use std::hint::black_box;
 use std::time::Duration;
+use tessera::baselines::cdf::RasterCdf;
 use tessera::baselines::envmap::{AliasTable, InverseCdf};
 use tessera::baselines::{
-    bridson, jittered_healpix, sobol, spherical_fibonacci, spherical_fibonacci_into,
+    bridson, jittered_healpix_about, sobol, spherical_fibonacci, spherical_fibonacci_into,
     uniform_random_2d, uniform_random_sphere,
 };
 use tessera::density::plane::Ramp;
 use tessera::density::sphere::Cap;
 use tessera::density::{Density, Region, Uniform};
 use tessera::engine;
+use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::PlaneTiling;
 use tessera::tiling::sphere::SphereTiling;
 use tessera::tiling::TileSystem;
@@ -118,7 +122,7 @@ fn sphere(c: &mut Criterion) {
         sobol::sphere(n, 1)
     });
     baseline(c, "sphere/uniform", "jittered_healpix", &IN_MEMORY, |n| {
-        jittered_healpix(((n as f64 / 12.0).sqrt().round() as usize).max(1), 1)
+        jittered_healpix_about(n, 1)
     });
     let cap = Cap::new(0.0, 45.0, 30.0, 10.0).expect("cap");
     tile_system(c, "sphere/cap", "tessera", &tiling, &cap, &IN_MEMORY[..2]);
@@ -142,7 +146,7 @@ fn sphere(c: &mut Criterion) {
     g.finish();
 }
 
-/// The planar systems; a new one (Penrose) is benchmarked by adding it here.
+/// The polyomino systems (Penrose, another tile type, is benchmarked beside them).
 fn plane_systems() -> [(&'static str, PlaneTiling); 2] {
     [
         ("ghexomino", PlaneTiling::ghexomino()),
@@ -150,11 +154,68 @@ fn plane_systems() -> [(&'static str, PlaneTiling); 2] {
     ]
 }
 
+/// A 256x256 image density (a gradient and a bright disc) against the
+/// inverse-CDF baselines over its pixels: i.i.d. and Owen-scrambled Sobol.
+fn raster(c: &mut Criterion) {
+    let side = 256;
+    let values: Vec<f64> = (0..side * side)
+        .map(|k| {
+            let (x, y) = (
+                (k % side) as f64 / side as f64,
+                (k / side) as f64 / side as f64,
+            );
+            let disc = if (x - 0.6).hypot(y - 0.4) < 0.15 {
+                20.0
+            } else {
+                0.0
+            };
+            0.1 + x + disc
+        })
+        .collect();
+    let image = tessera::density::plane::Raster::new(side, side, values, false).expect("image");
+    let sizes = &IN_MEMORY[..2];
+    for (name, tiling) in plane_systems() {
+        tile_system(c, "plane/raster", name, &tiling, &image, sizes);
+    }
+    tile_system(
+        c,
+        "plane/raster",
+        "penrose",
+        &PenroseTiling::default(),
+        &image,
+        sizes,
+    );
+    let cdf = RasterCdf::new(&image).expect("a lit image");
+    baseline(c, "plane/raster", "iid_inverse_cdf", sizes, |n| {
+        uniform_random_2d(n, 1)
+            .into_iter()
+            .map(|u| cdf.warp(u))
+            .collect()
+    });
+    baseline(c, "plane/raster", "sobol_inverse_cdf", sizes, |n| {
+        sobol::owen_sobol_2d(n, 1)
+            .into_iter()
+            .map(|u| cdf.warp(u))
+            .collect()
+    });
+}
+
 fn plane(c: &mut Criterion) {
     for (name, tiling) in plane_systems() {
         tile_system(c, "plane/uniform", name, &tiling, &Uniform, &IN_MEMORY);
         tile_system(c, "plane/ramp", name, &tiling, &Ramp, &IN_MEMORY[..2]);
     }
+    let penrose = PenroseTiling::default();
+    tile_system(
+        c,
+        "plane/uniform",
+        "penrose",
+        &penrose,
+        &Uniform,
+        &IN_MEMORY,
+    );
+    tile_system(c, "plane/ramp", "penrose", &penrose, &Ramp, &IN_MEMORY[..2]);
+    raster(c);
     baseline(c, "plane/uniform", "iid", &IN_MEMORY, |n| {
         uniform_random_2d(n, 1)
     });

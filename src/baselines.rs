@@ -234,6 +234,18 @@ pub fn jittered_healpix(nside: usize, seed: u64) -> Vec<DVec3> {
     out
 }
 
+/// [`jittered_healpix`] at the `nside` whose `12 nside²` cells come
+/// nearest to `n` (at least 12 points).
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::baselines::jittered_healpix_about(1000, 1).len(), 12 * 9 * 9);
+/// ```
+pub fn jittered_healpix_about(n: usize, seed: u64) -> Vec<DVec3> {
+    let nside = ((n as f64 / 12.0).sqrt().round() as usize).max(1);
+    jittered_healpix(nside, seed)
+}
+
 /// Bridson's Poisson-disk sampling of the unit square (the `fast_poisson`
 /// crate) with the radius `√(0.7 / n)` that gives about `n` points (the
 /// count varies with the seed; a maximal set at this radius holds about

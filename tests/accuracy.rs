@@ -71,6 +71,7 @@ fn tiny_accuracy_bench_fits_iid_slope_and_writes_its_files() {
         "bridson",
         "ghexomino",
         "ppentomino",
+        "penrose",
         "i.i.d. alias",
     ] {
         assert!(md.contains(needle), "{needle} missing from the report");

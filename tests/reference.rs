@@ -2,6 +2,7 @@
 
 use tessera::density::Uniform;
 use tessera::engine;
+use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::PlaneTiling;
 use tessera::tiling::reference::{ReferencePoint, WithoutOffsets};
 use tessera::tiling::sphere::SphereTiling;
@@ -40,4 +41,18 @@ fn without_offsets_keeps_codes_and_moves_samples_to_centroids() {
     check(SphereTiling::default());
     check(PlaneTiling::ghexomino());
     check(PlaneTiling::ppentomino());
+}
+
+#[test]
+fn penrose_without_offsets_samples_point_tile_vertices_in_the_square() {
+    let penrose = PenroseTiling::default();
+    let plain = WithoutOffsets(penrose.clone());
+    let a = engine::generate(&plain, &Uniform, 700, true).unwrap();
+    let b = engine::generate(&penrose, &Uniform, 700, true).unwrap();
+    assert_eq!(a.len(), 700);
+    assert!(a
+        .iter()
+        .all(|s| s.position.cmpge(glam::DVec2::ZERO).all()
+            && s.position.cmplt(glam::DVec2::ONE).all()));
+    assert_ne!(a, b, "the offsets move the samples");
 }

@@ -1,6 +1,6 @@
 //! The compared samplers in each scenario. Tile systems enter through
 //! [`uniform_tile_methods`] (one line each; a new system such as Penrose
-//! tiles is added beside the polyomino systems in [`plane_uniform`]).
+//! tiles sit beside the polyomino systems in [`plane_uniform`]).
 //!
 //! Knobs of the tile samplers, each a method of its own:
 //! - default: offset tables on, f64 output, exact N, randomised;
@@ -15,12 +15,13 @@
 use super::{integrands, Generator, Method, Scenario};
 use crate::baselines::envmap::{AliasTable, InverseCdf};
 use crate::baselines::{
-    bridson, jittered_grid_2d, jittered_healpix, random_rotation, sobol, spherical_fibonacci,
+    bridson, jittered_grid_2d, jittered_healpix_about, random_rotation, sobol, spherical_fibonacci,
     uniform_random_2d, uniform_random_sphere, SplitMix64,
 };
 use crate::density::envmap::EnvMap;
 use crate::density::{Region, Uniform};
 use crate::engine;
+use crate::tiling::penrose::PenroseTiling;
 use crate::tiling::plane::PlaneTiling;
 use crate::tiling::reference::{ReferencePoint, WithoutOffsets};
 use crate::tiling::sphere::{SphereRegion, SphereTiling};
@@ -113,10 +114,7 @@ pub(super) fn sphere_uniform<'a>() -> Scenario<'a, DVec3> {
         method("fibonacci", false, |n, seed| {
             rotate(spherical_fibonacci(n), seed)
         }),
-        method("jittered-healpix", false, |n, seed| {
-            let nside = ((n as f64 / 12.0).sqrt().round() as usize).max(1);
-            jittered_healpix(nside, seed)
-        }),
+        method("jittered-healpix", false, jittered_healpix_about),
     ]);
     Scenario {
         name: "sphere-uniform",
@@ -192,7 +190,12 @@ pub(super) fn plane_uniform<'a>() -> Scenario<'a, DVec2> {
         shift,
         to_f32,
     ));
-    // Penrose tiles (in progress elsewhere) join here the same way.
+    methods.extend(uniform_tile_methods(
+        "penrose",
+        PenroseTiling::default(),
+        shift,
+        to_f32,
+    ));
     methods.extend([
         method("i.i.d.", false, uniform_random_2d),
         method("sobol", false, sobol::owen_sobol_2d),

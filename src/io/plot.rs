@@ -22,7 +22,7 @@ use std::f64::consts::{PI, TAU};
 /// ```
 /// assert_eq!(tessera::io::plot::PALETTE.len(), tessera::io::plot::PALETTE_NAMES.len());
 /// ```
-pub const PALETTE: [[u8; 3]; 12] = [
+pub const PALETTE: [[u8; 3]; 16] = [
     [228, 26, 28],
     [55, 126, 184],
     [77, 175, 74],
@@ -35,6 +35,10 @@ pub const PALETTE: [[u8; 3]; 12] = [
     [23, 190, 207],
     [188, 189, 34],
     [0, 0, 140],
+    [128, 0, 0],
+    [0, 128, 128],
+    [230, 190, 0],
+    [170, 110, 255],
 ];
 
 /// Names of the [`PALETTE`] colours.
@@ -43,9 +47,9 @@ pub const PALETTE: [[u8; 3]; 12] = [
 /// ```
 /// assert_eq!(tessera::io::plot::PALETTE_NAMES[0], "red");
 /// ```
-pub const PALETTE_NAMES: [&str; 12] = [
+pub const PALETTE_NAMES: [&str; 16] = [
     "red", "blue", "green", "purple", "orange", "brown", "pink", "grey", "black", "cyan", "olive",
-    "navy",
+    "navy", "maroon", "teal", "gold", "lavender",
 ];
 
 const WHITE: Luma<u8> = Luma([255]);

@@ -623,3 +623,14 @@ impl TileSystem for PenroseTiling {
         DVec2::new(mirror_unit(p.x), mirror_unit(p.y))
     }
 }
+
+impl super::reference::ReferencePoint for PenroseTiling {
+    fn reference(&self, tile: &PenroseTile) -> DVec2 {
+        let p = tile.v[0];
+        DVec2::new(mirror_unit(p.x), mirror_unit(p.y))
+    }
+
+    fn reference_in_domain(&self, tile: &PenroseTile) -> Option<DVec2> {
+        in_square(tile.v[0]).then_some(tile.v[0])
+    }
+}

@@ -1,7 +1,7 @@
 //! The "offset tables off" knob: [`WithoutOffsets`] places each accepted
-//! tile's sample at the tile's reference point (its centroid) instead of
-//! reference point plus table offset, so the accuracy bench can measure
-//! what the optimised offsets buy.
+//! tile's sample at the tile's reference point (the polyominoes' centroid,
+//! the Penrose point tiles' vertex) instead of reference point plus table
+//! offset, so the accuracy bench can measure what the optimised offsets buy.
 //!
 //! ```
 //! use tessera::tiling::{reference::WithoutOffsets, sphere::SphereTiling, TileSystem};
@@ -23,8 +23,14 @@ use super::{Code, TileSystem};
 /// assert!(p.x >= 0.0 && p.x < 1.0);
 /// ```
 pub trait ReferencePoint: TileSystem {
-    /// The tile's centroid, in the system's point space.
+    /// The point the tile's offsets are relative to, in the system's point
+    /// space (mirrored into the domain as [`TileSystem::sample`] is).
     fn reference(&self, tile: &Self::Tile) -> Self::Point;
+    /// The reference point as the recursion places it: `None` outside the
+    /// domain (see [`TileSystem::sample_in_domain`]).
+    fn reference_in_domain(&self, tile: &Self::Tile) -> Option<Self::Point> {
+        Some(self.reference(tile))
+    }
 }
 
 /// `S` with every sample at its tile's [`ReferencePoint`]: same tiles,
@@ -85,6 +91,15 @@ impl<S: ReferencePoint> TileSystem for WithoutOffsets<S> {
         f: &(dyn Fn(Code, &S::Tile) -> T + Sync),
     ) -> Option<Vec<T>> {
         self.0.map_code_order(level, count, f)
+    }
+    fn carries_sample(&self, tile: &S::Tile) -> bool {
+        self.0.carries_sample(tile)
+    }
+    fn codes_per_sample(&self) -> f64 {
+        self.0.codes_per_sample()
+    }
+    fn sample_in_domain(&self, tile: &S::Tile, _fraction: f64) -> Option<S::Point> {
+        self.0.reference_in_domain(tile)
     }
     fn sample(&self, tile: &S::Tile, _fraction: f64) -> S::Point {
         self.0.reference(tile)
