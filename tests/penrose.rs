@@ -5,7 +5,9 @@
 mod common;
 
 use approx::assert_relative_eq;
-use common::plane::{check_counts, in_domain, photograph, ramp_expected, raster_mass};
+use common::plane::{
+    check_counts, in_domain, parse_xy, photograph, positions, ramp_expected, raster_mass,
+};
 use glam::DVec2;
 use std::collections::HashSet;
 use tessera::density::plane::{Ramp, Raster};
@@ -245,17 +247,6 @@ fn shipped_table_is_small_round_trips_and_corrupt_tables_are_refused() {
     assert!(PenroseLut::from_bytes(&wrong.to_bytes()).is_err());
 }
 
-fn positions<D>(t: &PenroseTiling, d: &D, n: usize) -> Vec<DVec2>
-where
-    D: tessera::density::Density<tessera::tiling::plane::PlaneRegion> + ?Sized,
-{
-    engine::generate(t, d, n, true)
-        .unwrap()
-        .iter()
-        .map(|s| s.position)
-        .collect()
-}
-
 #[test]
 fn uniform_4096_is_blue_noise() {
     let points = positions(&tiling(), &Uniform, 4096);
@@ -369,13 +360,7 @@ fn cli_samples_and_draws_the_penrose_tiling() {
         String::from_utf8_lossy(&run.stderr)
     );
     let text = std::fs::read_to_string(&out).unwrap();
-    let points: Vec<DVec2> = text
-        .lines()
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            DVec2::new(v[0], v[1])
-        })
-        .collect();
+    let points = parse_xy(&text);
     assert_eq!(points.len(), 777);
     assert!(points.iter().all(in_domain));
     let svg = dir.join("tiles.svg");

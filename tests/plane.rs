@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::plane::{check_counts, in_domain, photograph, ramp_expected, raster_mass};
+use common::plane::{check_counts, in_domain, photograph, positions, ramp_expected, raster_mass};
 use glam::DVec2;
 use proptest::prelude::*;
 use tessera::baselines::SplitMix64;
@@ -12,7 +12,7 @@ use tessera::density::{Density, Uniform};
 use tessera::engine;
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
 use tessera::metrics::plane::{low_frequency_power, min_distance, spectral_peaks};
-use tessera::tiling::plane::{PlaneRegion, PlaneTiling, MAX_LATTICE_SIDE};
+use tessera::tiling::plane::{PlaneTiling, MAX_LATTICE_SIDE};
 use tessera::tiling::{Code, TileSystem};
 
 fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
@@ -20,14 +20,6 @@ fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
         (PlaneSystem::Ghexomino, PlaneTiling::ghexomino()),
         (PlaneSystem::Ppentomino, PlaneTiling::ppentomino()),
     ]
-}
-
-fn positions<D: Density<PlaneRegion> + ?Sized>(t: &PlaneTiling, d: &D, n: usize) -> Vec<DVec2> {
-    engine::generate(t, d, n, true)
-        .unwrap()
-        .iter()
-        .map(|s| s.position)
-        .collect()
 }
 
 #[test]

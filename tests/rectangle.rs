@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::plane::{check_counts, in_domain, ramp_expected};
+use common::plane::{check_counts, in_domain, parse_xy, ramp_expected};
 use glam::DVec2;
 use tessera::density::plane::Ramp;
 use tessera::density::rectangle::Rectangle;
@@ -146,13 +146,7 @@ fn cli_samples_a_rectangle_and_refuses_bad_ones() {
         );
         let rect = Rectangle::new(1.0, -2.0, 3.0, -1.0).unwrap();
         let text = String::from_utf8(run.stdout).unwrap();
-        let points: Vec<DVec2> = text
-            .lines()
-            .map(|l| {
-                let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-                DVec2::new(v[0], v[1])
-            })
-            .collect();
+        let points = parse_xy(&text);
         assert_eq!(points.len(), 500);
         assert!(points.iter().all(|&p| rect.contains(p)), "{system}");
     }

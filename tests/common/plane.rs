@@ -5,6 +5,33 @@
 
 use glam::DVec2;
 use tessera::baselines::SplitMix64;
+use tessera::density::Density;
+use tessera::engine;
+use tessera::tiling::plane::PlaneRegion;
+use tessera::tiling::TileSystem;
+
+/// Exactly `n` sample positions of `density` on a planar system.
+pub fn positions<S, D>(system: &S, density: &D, n: usize) -> Vec<DVec2>
+where
+    S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+    D: Density<PlaneRegion> + ?Sized,
+{
+    engine::generate(system, density, n, true)
+        .unwrap()
+        .iter()
+        .map(|s| s.position)
+        .collect()
+}
+
+/// The points of `x y` lines (what `tessera plane` writes).
+pub fn parse_xy(text: &str) -> Vec<DVec2> {
+    text.lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            DVec2::new(v[0], v[1])
+        })
+        .collect()
+}
 
 /// Whether a point lies in `[0, 1)^2`.
 pub fn in_domain(p: &DVec2) -> bool {
