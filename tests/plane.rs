@@ -456,3 +456,32 @@ fn cli_samples_a_png_file_and_its_inverse() {
     let out = tessera(&["plane", "--system", "ppentomino", "--invert", "-n", "5"]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+/// How far the offset tables carry points beyond their tile's bounding box,
+/// in cells, over every tile of the first levels and 40 density fractions
+/// (printed with `--nocapture`): the planar tables are relaxed without a
+/// room around the tile, so points may leave it.
+#[test]
+fn offsets_stay_near_their_tiles() {
+    for (system, tiling) in systems() {
+        let levels = if tiling.lut().arity() == 4 {
+            0..=4
+        } else {
+            0..=2
+        };
+        let mut worst: f64 = 0.0;
+        for level in levels {
+            for tile in tiling.tiles(level) {
+                let r = tiling.region(&tile);
+                for k in 1..=40 {
+                    let p = tiling.sample(&tile, k as f64 / 40.0);
+                    let out = (r.lo - p).max(p - r.hi).max_element() / r.cell;
+                    worst = worst.max(out);
+                }
+            }
+        }
+        eprintln!("{system:?}: points reach {worst:.2} cells beyond their tile's box");
+        let bound = if tiling.lut().arity() == 4 { 3.0 } else { 8.0 };
+        assert!(worst < bound, "{system:?}: {worst}");
+    }
+}
