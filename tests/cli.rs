@@ -1,13 +1,7 @@
 //! The command line, end to end: formats, errors, drawings, metrics.
 
-use std::process::Command;
-
-fn tessera(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
+use common::tessera;
 
 fn stdout(args: &[&str]) -> String {
     let out = tessera(args);

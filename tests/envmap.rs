@@ -4,6 +4,7 @@
 //! per-pixel density; single-pixel maps; hostile files.
 
 mod common;
+use common::tessera;
 
 use common::sky;
 use glam::DVec3;
@@ -499,13 +500,6 @@ fn baselines_follow_the_map() {
             );
         }
     }
-}
-
-fn tessera(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .output()
-        .expect("run tessera")
 }
 
 #[test]

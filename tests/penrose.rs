@@ -3,6 +3,7 @@
 //! domain and determinism.
 
 mod common;
+use common::tessera;
 
 use approx::assert_relative_eq;
 use common::plane::{
@@ -329,13 +330,6 @@ fn the_sampler_builder_drives_the_penrose_tiling() {
         .iter()
         .zip(&pdfs)
         .all(|(s, &p)| (p - 2.0 * s.position.x).abs() < 1e-12));
-}
-
-fn tessera(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! domain, determinism and the shipped tables.
 
 mod common;
+use common::tessera;
 
 use common::plane::{check_counts, in_domain, photograph, positions, ramp_expected, raster_mass};
 use glam::DVec2;
@@ -300,13 +301,6 @@ proptest! {
             }
         }
     }
-}
-
-fn tessera(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
 }
 
 #[test]

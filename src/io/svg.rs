@@ -23,15 +23,7 @@ pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -
     let tiles: Vec<SphereTile> = tiling.tiles(level);
     let capacity = tiling.capacity(level);
     let outline = tiling.shape().outline();
-    let mut svg = String::new();
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}">"#
-    );
-    let _ = writeln!(
-        svg,
-        r#"<rect width="{WIDTH}" height="{HEIGHT}" fill="white"/>"#
-    );
+    let mut svg = open_svg(WIDTH, HEIGHT);
     let stroke = (0.8 / (1 << level) as f64).max(0.1);
     for tile in &tiles {
         let mut lonlats = Vec::new();
@@ -124,15 +116,7 @@ pub fn plane_tiles(
     let tiles = tiling.tiles(level);
     let capacity = tiling.capacity(level);
     let outline = tiling.shape().outline();
-    let mut svg = String::new();
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{side}" height="{side}" viewBox="0 0 {side} {side}">"#
-    );
-    let _ = writeln!(
-        svg,
-        r#"<rect width="{side}" height="{side}" fill="white"/>"#
-    );
+    let mut svg = open_svg(side, side);
     let stroke = (side / tiling.cells_per_unit(level) / 8.0).clamp(0.1, 1.0);
     let label = tiles.len() <= 400;
     let font = side / tiling.cells_per_unit(level) * 0.8;
@@ -183,18 +167,10 @@ pub fn penrose_tiles(
     let tiles = tiling.tiles(level);
     let capacity = tiling.capacity(level);
     let edge = tiling.edge(level) * side;
-    let mut svg = String::new();
+    let mut svg = open_svg(side, side);
     let _ = writeln!(
         svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{side}" height="{side}" viewBox="0 0 {side} {side}">"#
-    );
-    let _ = writeln!(
-        svg,
-        r#"<defs><clipPath id="square"><rect width="{side}" height="{side}"/></clipPath></defs>"#
-    );
-    let _ = writeln!(
-        svg,
-        r#"<rect width="{side}" height="{side}" fill="white"/><g clip-path="url(#square)">"#
+        r#"<defs><clipPath id="square"><rect width="{side}" height="{side}"/></clipPath></defs><g clip-path="url(#square)">"#
     );
     let stroke = (edge / 20.0).clamp(0.1, 1.0);
     for tile in tiles.iter().filter(|t| !t.kind.is_point()) {
@@ -236,4 +212,18 @@ fn unit_square_points(svg: &mut String, points: &[glam::DVec2], side: f64, radiu
             p.y * side
         );
     }
+}
+
+/// An SVG document opened at `width x height` pixels on a white background.
+fn open_svg(width: f64, height: f64) -> String {
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}">"#
+    );
+    let _ = writeln!(
+        svg,
+        r#"<rect width="{width}" height="{height}" fill="white"/>"#
+    );
+    svg
 }
