@@ -1,13 +1,20 @@
 //! Planar throughput: tessera's Penrose and polyomino systems at uniform
 //! density and on the ramp, one thread, against Bridson's Poisson-disk sampler
 //! (`fast_poisson`) in the same run. Run: `cargo bench --bench plane`.
+//!
+//! Each request is measured twice: into a fresh `Vec` (`engine::generate`,
+//! paying the first touch of `N` new samples' pages) and into a buffer kept
+//! across iterations (`engine::generate_into`, what a renderer drawing a set
+//! per frame pays). `fresh_buffer_write_only` writes `N` samples into a
+//! fresh `Vec` with no sampling at all: the floor of the first kind.
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
+use glam::DVec2;
 use std::hint::black_box;
 use tessera::baselines::bridson;
-use tessera::density::{plane::Ramp, Uniform};
-use tessera::engine;
+use tessera::density::{plane::Ramp, Density, Uniform};
+use tessera::engine::{self, Sample};
 use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
 use tessera::tiling::TileSystem;
@@ -28,21 +35,31 @@ fn systems() -> [(&'static str, PlaneTiling); 2] {
     ]
 }
 
-/// `N` samples at uniform density and on the ramp.
+/// `N` samples at uniform density and on the ramp, into fresh and reused
+/// buffers.
 fn uniform_and_ramp<S>(
     group: &mut BenchmarkGroup<'_, WallTime>,
     pool: &rayon::ThreadPool,
     name: &str,
     tiling: &S,
 ) where
-    S: TileSystem<Point = glam::DVec2, Region = PlaneRegion>,
+    S: TileSystem<Point = DVec2, Region = PlaneRegion>,
 {
-    group.bench_function(format!("{name}_uniform"), |b| {
-        b.iter(|| pool.install(|| black_box(engine::generate(tiling, &Uniform, N, true))))
-    });
-    group.bench_function(format!("{name}_ramp"), |b| {
-        b.iter(|| pool.install(|| black_box(engine::generate(tiling, &Ramp, N, true))))
-    });
+    let densities: [(&str, &dyn Density<PlaneRegion>); 2] =
+        [("uniform", &Uniform), ("ramp", &Ramp)];
+    for (density_name, density) in densities {
+        group.bench_function(format!("{name}_{density_name}"), |b| {
+            b.iter(|| pool.install(|| black_box(engine::generate(tiling, density, N, true))))
+        });
+        let mut buffer = Vec::new();
+        group.bench_function(format!("{name}_{density_name}_reused_buffer"), |b| {
+            b.iter(|| {
+                pool.install(|| engine::generate_into(tiling, density, N, true, &mut buffer))
+                    .expect("samples");
+                black_box(&buffer);
+            })
+        });
+    }
 }
 
 fn throughput(c: &mut Criterion) {
@@ -50,6 +67,17 @@ fn throughput(c: &mut Criterion) {
     let mut group = c.benchmark_group("plane_1_thread");
     group.sample_size(10);
     group.throughput(Throughput::Elements(N as u64));
+    group.bench_function("fresh_buffer_write_only", |b| {
+        b.iter(|| {
+            let written: Vec<Sample<DVec2>> = (0..N)
+                .map(|i| Sample {
+                    position: DVec2::splat(i as f64),
+                    rank: i as f64,
+                })
+                .collect();
+            black_box(written)
+        })
+    });
     for (name, tiling) in systems() {
         uniform_and_ramp(&mut group, &pool, name, &tiling);
     }

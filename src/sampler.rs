@@ -113,6 +113,20 @@ where
         engine::generate(&self.system, &self.density, self.count, self.exact)
     }
 
+    /// [`Sampler::generate`] into a buffer whose capacity is reused (see
+    /// [`engine::generate_into`]): for a new set every frame.
+    ///
+    /// # Example
+    /// ```
+    /// let sampler = tessera::Sampler::sphere().count(100);
+    /// let mut frame = Vec::new();
+    /// sampler.generate_into(&mut frame).unwrap();
+    /// assert_eq!(frame, sampler.generate().unwrap());
+    /// ```
+    pub fn generate_into(&self, out: &mut Vec<Sample<S::Point>>) -> Result<(), Error> {
+        engine::generate_into(&self.system, &self.density, self.count, self.exact, out)
+    }
+
     /// The pdf (per unit measure) the samples follow at `point`.
     ///
     /// # Example

@@ -13,7 +13,7 @@ use tessera::density::{Density, Uniform};
 use tessera::engine;
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
 use tessera::metrics::plane::{low_frequency_power, min_distance, spectral_peaks};
-use tessera::tiling::plane::{PlaneTiling, MAX_LATTICE_SIDE};
+use tessera::tiling::plane::{PlaneRegion, PlaneTiling, MAX_LATTICE_SIDE};
 use tessera::tiling::{Code, TileSystem};
 
 fn systems() -> [(PlaneSystem, PlaneTiling); 2] {
@@ -183,13 +183,52 @@ fn one_and_two_threads_give_the_same_samples() {
 }
 
 #[test]
-fn streaming_matches_generation() {
-    for (_, tiling) in systems() {
-        let streamed: Vec<DVec2> = engine::stream(&tiling, 20_000)
-            .unwrap()
-            .map(|s| s.position)
-            .collect();
-        assert_eq!(streamed, positions(&tiling, &Uniform, 20_000));
+fn streaming_recursion_and_the_uniform_fast_path_agree() {
+    for (system, tiling) in systems() {
+        for n in [1usize, 333, 20_000] {
+            let fast = engine::generate(&tiling, &Uniform, n, true).unwrap();
+            let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
+            assert_eq!(streamed, fast, "{system:?}, n = {n}");
+            // the general recursion, ranked by sorting, finds the same set in the same order
+            let mut recursed = engine::collect(&tiling, &Uniform, n as f64);
+            recursed.sort_by(|a, b| a.rank.total_cmp(&b.rank));
+            assert_eq!(recursed, fast, "{system:?}, n = {n}");
+        }
+    }
+}
+
+/// A density with no mass, which every request refuses.
+struct Zero;
+
+impl Density<PlaneRegion> for Zero {
+    fn bound(&self, _: &PlaneRegion) -> f64 {
+        0.0
+    }
+    fn average(&self, _: &PlaneRegion) -> f64 {
+        0.0
+    }
+    fn value(&self, _: DVec2) -> f64 {
+        0.0
+    }
+    fn mean(&self) -> f64 {
+        0.0
+    }
+}
+
+#[test]
+fn a_reused_buffer_gives_what_a_fresh_one_does() {
+    for (system, tiling) in systems() {
+        let mut buffer = Vec::new();
+        // growing, shrinking, and switching between the fast path and the recursion
+        for (n, ramp) in [(5000, false), (300, false), (2000, true), (8000, false)] {
+            let density: &dyn Density<PlaneRegion> = if ramp { &Ramp } else { &Uniform };
+            engine::generate_into(&tiling, density, n, true, &mut buffer).unwrap();
+            let fresh = engine::generate(&tiling, density, n, true).unwrap();
+            assert_eq!(buffer, fresh, "{system:?}, n = {n}, ramp {ramp}");
+        }
+        // a refused request leaves no stale samples behind
+        assert!(engine::generate_into(&tiling, &Zero, 10, true, &mut buffer).is_err());
+        assert!(buffer.is_empty());
     }
 }
 

@@ -120,18 +120,21 @@ pub trait TileSystem: Sync {
             .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
             .collect()
     }
-    /// The samples of the tiles of `level` with codes `0..count` (what a
+    /// Writes into `out` (replacing its contents, reusing its capacity) the
+    /// samples of the tiles of `level` with codes `0..count` (what a
     /// constant density of `d` samples per domain accepts: density
     /// `fraction` of the level's capacity), ranked `code / d`, in code
-    /// order; `None` as for [`TileSystem::map_code_order`]. The default
-    /// samples every tile that method yields; systems override it to place
-    /// points without building whole tiles.
+    /// order. False, leaving `out` unspecified, as
+    /// [`TileSystem::map_code_order`] returns `None`. The default samples
+    /// every tile that method yields; systems override it to place points
+    /// without building whole tiles.
     ///
     /// # Example
     /// ```
     /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
     /// let sphere = SphereTiling::default();
-    /// let s = sphere.code_order_samples(1, 500, 500.0 / 960.0, 500.0).unwrap();
+    /// let mut s = Vec::new();
+    /// assert!(sphere.code_order_samples(1, 500, 500.0 / 960.0, 500.0, &mut s));
     /// assert_eq!(s.len(), 500);
     /// assert_eq!(s[10].rank, 10.0 / 500.0);
     /// ```
@@ -141,8 +144,9 @@ pub trait TileSystem: Sync {
         count: usize,
         fraction: f64,
         d: f64,
-    ) -> Option<Vec<Sample<Self::Point>>> {
-        samples_in_code_order(self, level, count, fraction, d)
+        out: &mut Vec<Sample<Self::Point>>,
+    ) -> bool {
+        samples_in_code_order(self, level, count, fraction, d, out)
     }
     /// Whether a terminal tile carries a sample. Penrose triangles only
     /// subdivide: its point tiles carry the samples.
@@ -188,13 +192,14 @@ pub(crate) fn mirror_unit(v: f64) -> f64 {
 }
 
 /// [`TileSystem::code_order_samples`]'s default: every tile
-/// [`TileSystem::map_code_order`] yields, sampled (for systems that override
-/// the method and fall back to it).
+/// [`TileSystem::map_code_order`] yields, sampled into `out` (for systems
+/// that override the method and fall back to it).
 ///
 /// # Example
 /// ```
 /// use tessera::tiling::{samples_in_code_order, sphere::SphereTiling};
-/// let s = samples_in_code_order(&SphereTiling::default(), 0, 3, 0.0125, 3.0).unwrap();
+/// let mut s = Vec::new();
+/// assert!(samples_in_code_order(&SphereTiling::default(), 0, 3, 0.0125, 3.0, &mut s));
 /// assert_eq!(s.len(), 3);
 /// ```
 pub fn samples_in_code_order<S: TileSystem + ?Sized>(
@@ -203,9 +208,11 @@ pub fn samples_in_code_order<S: TileSystem + ?Sized>(
     count: usize,
     fraction: f64,
     d: f64,
-) -> Option<Vec<Sample<S::Point>>> {
-    system.map_code_order(level, count, &|code, tile| Sample {
+    out: &mut Vec<Sample<S::Point>>,
+) -> bool {
+    let samples = system.map_code_order(level, count, &|code, tile| Sample {
         position: system.sample(tile, fraction),
         rank: code_value(code) / d,
-    })
+    });
+    samples.map(|samples| *out = samples).is_some()
 }

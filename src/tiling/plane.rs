@@ -507,25 +507,38 @@ impl TileSystem for PlaneTiling {
         count: usize,
         fraction: f64,
         d: f64,
-    ) -> Option<Vec<Sample<DVec2>>> {
+        out: &mut Vec<Sample<DVec2>>,
+    ) -> bool {
         if level < 2 || level > self.max_level || count as f64 > self.capacity(level) {
-            return samples_in_code_order(self, level, count, fraction, d);
+            return samples_in_code_order(self, level, count, fraction, d, out);
         }
         let (bin, s, a) = (
             self.bin(fraction),
             self.inv_size[level as usize],
             self.arity,
         );
+        // the bin's offsets in each orientation (exact: the matrices are
+        // signed permutations), so a point costs one lookup, no rotation
+        let turned: Vec<[f64; 2]> = self
+            .offsets
+            .iter()
+            .skip(bin)
+            .step_by(self.bins)
+            .flat_map(|&offset| Orientation::ALL.map(|o| o.apply_f64(offset)))
+            .collect();
         let m1 = self.digit_weight[level as usize - 1] as usize;
         let m2 = self.digit_weight[level as usize - 2] as usize;
-        let grandparents = self.map_code_order(level - 2, count.min(m2), &|_, t| {
+        let Some(grandparents) = self.map_code_order(level - 2, count.min(m2), &|_, t| {
             (t.placement, t.rule, t.class)
-        })?;
+        }) else {
+            return false;
+        };
         let unset = Sample {
             position: DVec2::ZERO,
             rank: 0.0,
         };
-        let mut out = vec![unset; count];
+        out.clear();
+        out.resize(count, unset);
         // runs[e]: the output runs of the parents of digit `e`, one per `d`
         let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
         for (q, run) in out.chunks_mut(m2).enumerate() {
@@ -546,15 +559,22 @@ impl TileSystem for PlaneTiling {
                     let Some(slot) = run.get_mut(k) else { continue };
                     let child = self.child_of_digit[rule * a + *digit] as usize;
                     let placement = self.child_placement(&parent, rule * a + child);
-                    let class = self.lut.transitions[class * a + child];
+                    let class = self.lut.transitions[class * a + child] as usize;
+                    let (x, y) = placement.origin;
+                    let [dx, dy] = turned[class * 8 + placement.orientation.index()];
+                    // codes stay far below 2^53: exact as f64, as in the recursion
+                    let code = (*digit * m1 + e * m2 + k) as i64;
                     *slot = Sample {
-                        position: self.place(&placement, class, bin, s),
-                        rank: (*digit * m1 + e * m2 + k) as f64 / d,
+                        position: DVec2::new(
+                            mirror_unit((x as f64 + dx) * s),
+                            mirror_unit((y as f64 + dy) * s),
+                        ),
+                        rank: code as f64 / d,
                     };
                 }
             }
         });
-        Some(out)
+        true
     }
 
     fn tile_with_code(&self, level: u32, code: Code) -> Option<PlaneTile> {
