@@ -2,8 +2,10 @@
 //!
 //! ```text
 //! visit(tile, b = the parent's scaled bound, which bounds the tile too):
-//!     if capacity(level) >= b and code(tile) + 1/2 >= b: return   (rejected unseen)
-//!     if capacity(level) >= magnitude * bound(tile) / mean:      terminal
+//!     if capacity(level) >= b:                     terminal, its own bound unneeded
+//!         if code(tile) + 1/2 >= b: return         (rejected unseen)
+//!     else b = magnitude * bound(tile) / mean;  terminal if capacity(level) >= b
+//!     if terminal:
 //!         d = magnitude * average(tile) / mean
 //!         if code(tile) + 1/2 < d:
 //!             p = sample(tile, d / capacity(level))
@@ -124,6 +126,9 @@ where
     let walker = Walker {
         system,
         density,
+        capacities: (0..=system.max_level() + 1)
+            .map(|level| system.capacity(level))
+            .collect(),
         // thresholds compare codes, so the request goes in code units
         magnitude: magnitude * system.codes_per_sample(),
         mean: density.mean(),
@@ -131,23 +136,38 @@ where
         window,
     };
     let roots = system.roots();
-    // under a constant density every root receives about the same share
-    let share = walker.constant.map_or(0, |c| {
-        (magnitude * c / roots.len() as f64 * 1.05) as usize + 16
-    });
+    // room for about a root's share (by the density's average over it), so
+    // that few outputs regrow: a guess, capped so that a wrong one (or a
+    // window's small part of a huge request) reserves little
+    let share = |root: &S::Tile| {
+        if window.is_some() {
+            return 16;
+        }
+        let average = walker
+            .constant
+            .unwrap_or_else(|| density.average(&system.region(root)));
+        let expected = magnitude * (average / walker.mean) / roots.len() as f64;
+        (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
+    };
     roots
         .par_iter()
         .map(|root| {
-            let mut out = Vec::with_capacity(share);
+            let mut out = Vec::with_capacity(share(root));
             walker.visit(root, f64::INFINITY, &mut out);
             out
         })
         .collect()
 }
 
+/// The most samples a root's output reserves before it knows its count
+/// (24 MB of planar samples).
+const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
+
 struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
+    /// `system.capacity(level)` for levels `0..=max_level + 1`.
+    capacities: Vec<f64>,
     magnitude: f64,
     mean: f64,
     constant: Option<f64>,
@@ -162,12 +182,14 @@ where
     D: Density<S::Region> + ?Sized,
 {
     /// `parent_bound`: the parent's scaled bound, which bounds this tile
-    /// too: a tile it already makes terminal and rejects is skipped before
-    /// its region and bound are computed.
+    /// too: a tile it already makes terminal needs no bound of its own (most
+    /// tiles: those the recursion stops at), and one it also rejects is
+    /// skipped before its region is computed.
     fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
-        let capacity = self.system.capacity(level);
-        if capacity >= parent_bound && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
+        let capacity = self.capacities[level as usize];
+        let terminal_by_parent = capacity >= parent_bound;
+        if terminal_by_parent && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
             return;
         }
         let region =
@@ -178,11 +200,16 @@ where
             }
         }
         let (bound, average) = match (self.constant, &region) {
-            (Some(c), _) => (c, Some(c)),
-            (None, Some(region)) => self.density.bound_and_average(region),
+            (Some(c), _) => (self.magnitude * (c / self.mean), Some(c)),
+            (None, Some(region)) if terminal_by_parent => {
+                (parent_bound, Some(self.density.average(region)))
+            }
+            (None, Some(region)) => {
+                let (bound, average) = self.density.bound_and_average(region);
+                (self.magnitude * (bound / self.mean), average)
+            }
             (None, None) => unreachable!("a region exists whenever the density varies"),
         };
-        let bound = self.magnitude * (bound / self.mean);
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
         }
@@ -234,7 +261,7 @@ where
         }
         // children the bound already rejects (see `visit`'s first test) are
         // skipped before they are built
-        let child_rejects = self.system.capacity(level + 1) >= bound;
+        let child_rejects = self.capacities[level as usize + 1] >= bound;
         for i in 0..self.system.child_count(tile) {
             if child_rejects && code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
                 continue;
@@ -366,16 +393,16 @@ fn by_rank<P: Copy + Send + Sync>(
     keep: usize,
     out: &mut Vec<Sample<P>>,
 ) {
-    let samples = parts.concat();
     out.clear();
-    if samples.len() < u32::MAX as usize && samples.iter().all(|s| (0.0..1.0).contains(&s.rank)) {
-        let order = bucket_order(&samples);
-        let keep = keep.min(order.len());
-        out.par_extend(order[..keep].par_iter().map(|&i| samples[i as usize]));
+    let n: usize = parts.iter().map(Vec::len).sum();
+    let samples = || parts.iter().flatten();
+    if n < u32::MAX as usize && samples().all(|s| (0.0..1.0).contains(&s.rank)) {
+        bucket_by_rank(&parts, n, keep, out);
         return;
     }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in
     // root order): distinct keys, so any sort of them is deterministic
+    let samples = parts.concat();
     let mut keys: Vec<(u64, usize)> = samples
         .par_iter()
         .enumerate()
@@ -386,37 +413,54 @@ fn by_rank<P: Copy + Send + Sync>(
     out.par_extend(keys.par_iter().map(|&(_, i)| samples[i]));
 }
 
-/// The positions of samples with ranks in `[0, 1)` (what the engine's
-/// ranks are: `code / d` with `code + 1/2 < d`) in rank order, ties in
-/// position order: one bucket per sample by the rank's value (monotone in
-/// it), then each (typically tiny) bucket by rank and position.
-fn bucket_order<P>(samples: &[Sample<P>]) -> Vec<u32> {
-    let n = samples.len();
-    let bucket = |s: &Sample<P>| ((s.rank * n as f64) as usize).min(n.saturating_sub(1));
-    let mut start = vec![0u32; n + 1];
-    for s in samples {
+/// [`by_rank`] for the `n` samples of `parts` when their ranks lie in
+/// `[0, 1)` (the engine's ranks: `code / d` with `code + 1/2 < d`): a
+/// counting sort on the rank's value scaled to about four samples a
+/// bucket (monotone in the rank, so only samples within a bucket need
+/// ordering), scattering the samples themselves, then a stable sort of
+/// each bucket. Samples in buckets past the `keep`-th sample are skipped.
+fn bucket_by_rank<P: Copy>(
+    parts: &[Vec<Sample<P>>],
+    n: usize,
+    keep: usize,
+    out: &mut Vec<Sample<P>>,
+) {
+    let Some(&first) = parts.iter().flatten().next() else {
+        return;
+    };
+    let buckets = (n / 4).max(1);
+    let bucket = |s: &Sample<P>| ((s.rank * buckets as f64) as usize).min(buckets - 1);
+    let mut start = vec![0u32; buckets + 1];
+    for s in parts.iter().flatten() {
         start[bucket(s) + 1] += 1;
     }
-    for b in 0..n {
+    for b in 0..buckets {
         start[b + 1] += start[b];
     }
-    let mut order = vec![0u32; n];
+    // the buckets holding the `keep` smallest ranks
+    let used = start
+        .partition_point(|&end| (end as usize) < keep.min(n))
+        .min(buckets);
+    let len = start[used] as usize;
+    out.resize(len, first);
     // `start[b]` moves to the end of bucket b while filling, which is the
     // start of bucket b + 1 before filling
-    for (i, s) in samples.iter().enumerate() {
+    for s in parts.iter().flatten() {
         let b = bucket(s);
-        order[start[b] as usize] = i as u32;
-        start[b] += 1;
+        if b < used {
+            out[start[b] as usize] = *s;
+            start[b] += 1;
+        }
     }
     let mut lo = 0;
-    for &hi in &start[..n] {
+    for &hi in &start[..used] {
         let hi = hi as usize;
         if hi - lo > 1 {
-            order[lo..hi].sort_unstable_by_key(|&i| (total_order_key(samples[i as usize].rank), i));
+            out[lo..hi].sort_by(|a, b| a.rank.total_cmp(&b.rank));
         }
         lo = hi;
     }
-    order
+    out.truncate(keep);
 }
 
 /// An unsigned key ordered like [`f64::total_cmp`].

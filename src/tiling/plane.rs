@@ -109,43 +109,59 @@ pub struct PlaneTiling {
     steps: Vec<Placement>,
     /// `child_rule[rule * A + child]`.
     child_rule: Vec<u8>,
-    /// `child_digit[rule * A + child]`, as a [`Code`].
-    child_digit: Vec<Code>,
+    /// `code_steps[level * rules * A + rule * A + child]`: what the child's
+    /// digit adds to its parent's code (a lookup, not a 128-bit product).
+    code_steps: Vec<Code>,
     /// `child_of_digit[rule * A + digit]`.
     child_of_digit: Vec<u8>,
     /// Decoded offsets, `class * bins + bin`.
     offsets: Vec<[f64; 2]>,
-    /// The density fraction each bin was optimised for, increasing.
-    bin_fractions: Vec<f64>,
     /// Roots times `A^level`: the weight of a level's new digit.
     digit_weight: Vec<Code>,
     /// `1 / (side * scale^level)`: lattice to unit square.
     inv_size: Vec<f64>,
     /// The shape's cells and bounding box in each of the 8 orientations.
     frames: [Frame; 8],
+    /// The bin edges of [`PlaneTiling::bin`], widened by its tolerance and
+    /// padded with infinities to a power of two longer than `bins`, for a
+    /// branch-free binary search.
+    bin_edges: Vec<f64>,
 }
 
-/// A rep-tile's cells (lower-left corners) and the corners of its bounding
-/// box, relative to a placement's origin, in one orientation.
+/// A rep-tile's cell centres and the corners of its bounding box, relative
+/// to a placement's origin, in one orientation (in cells, as f64 so that a
+/// region costs a multiply-add per coordinate). `centres` is padded to
+/// [`MAX_CELLS`] by repeating the first, so a region is filled without
+/// branches; `count` says how many are real.
 #[derive(Clone, Debug, Default)]
 struct Frame {
-    cells: Vec<(Lattice, Lattice)>,
-    lo: (Lattice, Lattice),
-    hi: (Lattice, Lattice),
+    centres: [DVec2; MAX_CELLS],
+    count: u8,
+    lo: DVec2,
+    hi: DVec2,
 }
 
 impl Frame {
     fn new(shape: &Shape, orientation: Orientation) -> Self {
-        let cells: Vec<_> = Placement::new((0, 0), orientation).cells(shape).collect();
-        let corner = |pick: fn(Lattice, Lattice) -> Lattice, far: Lattice| {
-            let x = cells.iter().map(|c| c.0).reduce(pick).unwrap_or(0);
-            let y = cells.iter().map(|c| c.1).reduce(pick).unwrap_or(0);
-            (x + far, y + far)
-        };
+        let corners: Vec<DVec2> = Placement::new((0, 0), orientation)
+            .cells(shape)
+            .map(|(x, y)| DVec2::new(x as f64, y as f64))
+            .collect();
+        let lo = corners
+            .iter()
+            .copied()
+            .reduce(DVec2::min)
+            .unwrap_or_default();
+        let hi = corners
+            .iter()
+            .copied()
+            .reduce(DVec2::max)
+            .unwrap_or_default();
         Frame {
-            lo: corner(Lattice::min, 0),
-            hi: corner(Lattice::max, 1),
-            cells,
+            centres: std::array::from_fn(|i| corners.get(i).unwrap_or(&corners[0]) + 0.5),
+            count: corners.len() as u8,
+            lo,
+            hi: hi + 1.0,
         }
     }
 }
@@ -164,7 +180,7 @@ impl PlaneTiling {
         let scale = lut.rules[0].scale;
         let roots = lut.roots.len() as Code;
         let max_level = deepest_level(lut.side, scale, roots, arity as Code);
-        let digit_weight = (0..=max_level)
+        let digit_weight: Vec<Code> = (0..=max_level)
             .map(|l| roots * (arity as Code).pow(l))
             .collect();
         let inv_size = (0..=max_level)
@@ -179,11 +195,10 @@ impl PlaneTiling {
             })
             .collect();
         let child_rule = lut.child_rule.concat();
-        let child_digit: Vec<Code> = lut
-            .child_digit
-            .concat()
+        let child_digit = lut.child_digit.concat();
+        let code_steps = digit_weight
             .iter()
-            .map(|&d| d as Code)
+            .flat_map(|&weight| child_digit.iter().map(move |&d| d as Code * weight))
             .collect();
         let mut child_of_digit = vec![0u8; child_digit.len()];
         for (at, &d) in child_digit.iter().enumerate() {
@@ -193,8 +208,12 @@ impl PlaneTiling {
         let offsets = (0..lut.classes() * lut.bins as usize)
             .map(|k| lut.offset(k / lut.bins as usize, k % lut.bins as usize))
             .collect();
-        let bin_fractions = (0..lut.bins as usize)
-            .map(|b| lut.bin_fraction(b))
+        // a relative tolerance keeps exact bin fractions in their own bin
+        let bin_edges = (0..(lut.bins as usize + 1).next_power_of_two())
+            .map(|b| match b < lut.bins as usize {
+                true => lut.bin_fraction(b) * (1.0 + 1e-9),
+                false => f64::INFINITY,
+            })
             .collect();
         let mut roots_by_code: Vec<PlaneTile> = (0..lut.roots.len())
             .map(|r| PlaneTile {
@@ -214,13 +233,13 @@ impl PlaneTiling {
             roots_by_code,
             steps,
             child_rule,
-            child_digit,
+            code_steps,
             child_of_digit,
             offsets,
-            bin_fractions,
             digit_weight,
             inv_size,
             frames: Orientation::ALL.map(|o| Frame::new(&lut.shape, o)),
+            bin_edges,
             lut,
         }
     }
@@ -281,11 +300,17 @@ impl PlaneTiling {
     }
 
     /// Child `child` (rule order) of `tile`.
-    #[inline]
+    #[inline(always)]
     fn subdivide(&self, tile: &PlaneTile, child: usize) -> PlaneTile {
+        self.child_coded(tile, child, self.child_code_of(tile, child))
+    }
+
+    /// The code of child `child` of `tile`.
+    #[inline(always)]
+    fn child_code_of(&self, tile: &PlaneTile, child: usize) -> Code {
         let at = tile.rule as usize * self.arity + child;
-        let code = tile.code + self.child_digit[at] * self.digit_weight[tile.level as usize];
-        self.child_coded(tile, child, code)
+        let per_level = self.child_rule.len();
+        tile.code + self.code_steps[tile.level as usize * per_level + at]
     }
 
     /// Child `child` of `tile`, whose code the caller already knows.
@@ -366,11 +391,17 @@ impl PlaneTiling {
     /// ```
     #[inline]
     pub fn bin(&self, fraction: f64) -> usize {
-        // a relative tolerance keeps exact bin fractions in their own bin
-        let b = self
-            .bin_fractions
-            .partition_point(|&edge| edge * (1.0 + 1e-9) < fraction);
-        b.min(self.bins - 1)
+        // the number of edges below `fraction`, found by halving steps:
+        // every edge before `below` lies below it
+        let mut below = 0;
+        let mut step = self.bin_edges.len() / 2;
+        while step > 0 {
+            if self.bin_edges[below + step - 1] < fraction {
+                below += step;
+            }
+            step /= 2;
+        }
+        below.min(self.bins - 1)
     }
 
     #[inline]
@@ -416,8 +447,13 @@ impl TileSystem for PlaneTiling {
         self.arity
     }
 
+    #[inline(always)]
     fn child(&self, tile: &PlaneTile, i: usize) -> PlaneTile {
         self.subdivide(tile, i)
+    }
+
+    fn child_code(&self, tile: &PlaneTile, i: usize) -> Code {
+        self.child_code_of(tile, i)
     }
 
     fn level(&self, tile: &PlaneTile) -> u32 {
@@ -445,19 +481,15 @@ impl TileSystem for PlaneTiling {
 
     fn region(&self, tile: &PlaneTile) -> PlaneRegion {
         let s = self.inv_size[tile.level as usize];
-        let (x0, y0) = tile.placement.origin;
-        let at = |(dx, dy): (Lattice, Lattice)| DVec2::new((x0 + dx) as f64, (y0 + dy) as f64) * s;
+        let (x, y) = tile.placement.origin;
+        let origin = DVec2::new(x as f64, y as f64);
         let frame = &self.frames[tile.placement.orientation.index()];
-        let mut cells = [DVec2::ZERO; MAX_CELLS];
-        for (cell, &offset) in cells.iter_mut().zip(&frame.cells) {
-            *cell = at(offset) + 0.5 * s;
-        }
         PlaneRegion {
-            lo: at(frame.lo),
-            hi: at(frame.hi),
+            lo: (origin + frame.lo) * s,
+            hi: (origin + frame.hi) * s,
             cell: s,
-            cells,
-            count: frame.cells.len() as u8,
+            cells: frame.centres.map(|centre| (origin + centre) * s),
+            count: frame.count,
         }
     }
 
