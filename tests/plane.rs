@@ -294,6 +294,34 @@ fn shipped_tables_are_small_and_round_trip() {
 }
 
 #[test]
+fn bins_are_the_first_optimised_for_at_least_the_fraction() {
+    for (system, tiling) in systems() {
+        let lut = tiling.lut();
+        let bins = lut.bins as usize;
+        // the definition: the number of (tolerance-widened) bin fractions
+        // below the fraction, at most the last bin
+        let expected = |f: f64| {
+            let below = (0..bins)
+                .filter(|&b| lut.bin_fraction(b) * (1.0 + 1e-9) < f)
+                .count();
+            below.min(bins - 1)
+        };
+        let mut fractions = vec![0.0, 1e-300, 1e-9, 0.3, 0.5, 1.0, 1.5, f64::NAN];
+        for b in 0..bins {
+            let f = lut.bin_fraction(b);
+            fractions.extend([f, f * (1.0 + 1e-12), f * (1.0 + 2e-9), f * (1.0 - 1e-12)]);
+            fractions.extend([f64::from_bits(f.to_bits() + 1), f64::from_bits(f.to_bits() - 1)]);
+        }
+        let mut rng = SplitMix64::new(7);
+        fractions.extend((0..20_000).map(|_| rng.next_f64()));
+        for f in fractions {
+            let want = if f.is_nan() { 0 } else { expected(f) };
+            assert_eq!(tiling.bin(f), want, "{system:?}, fraction {f:e}");
+        }
+    }
+}
+
+#[test]
 fn codes_of_a_level_are_a_permutation() {
     for (_, tiling) in systems() {
         let level = 1;
