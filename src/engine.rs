@@ -260,9 +260,23 @@ where
             }
         }
         // children the bound already rejects (see `visit`'s first test) are
-        // skipped before they are built
+        // skipped before they are built; in code order, the first such child
+        // ends the loop
+        let count = self.system.child_count(tile);
         let child_rejects = self.capacities[level as usize + 1] >= bound;
-        for i in 0..self.system.child_count(tile) {
+        if child_rejects && self.system.child_by_code_rank(tile, 0).is_some() {
+            for rank in 0..count {
+                let Some(i) = self.system.child_by_code_rank(tile, rank) else {
+                    break;
+                };
+                if code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
+                    break;
+                }
+                self.visit(&self.system.child(tile, i), bound, out);
+            }
+            return;
+        }
+        for i in 0..count {
             if child_rejects && code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
                 continue;
             }

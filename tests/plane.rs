@@ -310,7 +310,10 @@ fn bins_are_the_first_optimised_for_at_least_the_fraction() {
         for b in 0..bins {
             let f = lut.bin_fraction(b);
             fractions.extend([f, f * (1.0 + 1e-12), f * (1.0 + 2e-9), f * (1.0 - 1e-12)]);
-            fractions.extend([f64::from_bits(f.to_bits() + 1), f64::from_bits(f.to_bits() - 1)]);
+            fractions.extend([
+                f64::from_bits(f.to_bits() + 1),
+                f64::from_bits(f.to_bits() - 1),
+            ]);
         }
         let mut rng = SplitMix64::new(7);
         fractions.extend((0..20_000).map(|_| rng.next_f64()));

@@ -95,6 +95,27 @@ pub trait TileSystem: Sync {
     fn child_code(&self, tile: &Self::Tile, i: usize) -> Code {
         self.code(&self.child(tile, i))
     }
+    /// The child (production-rule index) holding the `rank`-th smallest code
+    /// among `tile`'s children, when the system knows it without comparing
+    /// codes (base-A codes: the child of digit `rank`); `None` otherwise.
+    /// With it the engine visits the children a bound makes terminal in
+    /// code order and stops at the first the bound rejects, instead of
+    /// testing all `A` of them.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
+    /// let t = PlaneTiling::ghexomino();
+    /// let root = t.roots()[0];
+    /// let codes: Vec<_> = (0..81)
+    ///     .map(|r| t.child_code(&root, t.child_by_code_rank(&root, r).unwrap()))
+    ///     .collect();
+    /// assert!(codes.windows(2).all(|w| w[0] < w[1]));
+    /// ```
+    fn child_by_code_rank(&self, tile: &Self::Tile, rank: usize) -> Option<usize> {
+        let _ = (tile, rank);
+        None
+    }
     /// The region a density bounds itself over.
     fn region(&self, tile: &Self::Tile) -> Self::Region;
     /// The tile of `level` whose code is `code`, when the system can find it

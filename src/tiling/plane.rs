@@ -456,6 +456,13 @@ impl TileSystem for PlaneTiling {
         self.child_code_of(tile, i)
     }
 
+    /// Codes grow with the child's digit.
+    #[inline(always)]
+    fn child_by_code_rank(&self, tile: &PlaneTile, rank: usize) -> Option<usize> {
+        let at = tile.rule as usize * self.arity + rank;
+        (rank < self.arity).then(|| self.child_of_digit[at] as usize)
+    }
+
     fn level(&self, tile: &PlaneTile) -> u32 {
         tile.level as u32
     }

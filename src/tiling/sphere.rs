@@ -332,6 +332,12 @@ impl TileSystem for SphereTiling {
         tile.code + digit * ((ROOT_COUNT as Code) << (2 * tile.level as u32))
     }
 
+    /// Codes grow with the child's digit.
+    fn child_by_code_rank(&self, tile: &SphereTile, rank: usize) -> Option<usize> {
+        let children = &self.child_of_digit[tile.rule as usize];
+        children.get(rank).map(|&child| child as usize)
+    }
+
     fn region(&self, tile: &SphereTile) -> SphereRegion {
         let centroid = self.centroid;
         let cell = |i: usize| {
