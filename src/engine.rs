@@ -192,14 +192,34 @@ where
         if terminal_by_parent && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
             return;
         }
-        let region =
-            (self.constant.is_none() || self.window.is_some()).then(|| self.system.region(tile));
-        if let (Some(window), Some(region)) = (self.window, &region) {
-            if !window(region) {
+        // the region is built in place and lent (an `Option` of it would be
+        // a copy of a large struct per tile)
+        if self.constant.is_some() && self.window.is_none() {
+            self.decide(tile, level, capacity, parent_bound, None, out);
+        } else {
+            let region = self.system.region(tile);
+            if self.window.is_some_and(|window| !window(&region)) {
                 return;
             }
+            self.decide(tile, level, capacity, parent_bound, Some(&region), out);
         }
-        let (bound, average) = match (self.constant, &region) {
+    }
+
+    /// [`Walker::visit`] past its first tests: the tile's bound and
+    /// average decide whether it is terminal, and a terminal tile's code
+    /// whether it is kept; the others recurse.
+    #[inline(always)]
+    fn decide(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        capacity: f64,
+        parent_bound: f64,
+        region: Option<&S::Region>,
+        out: &mut Vec<Sample<S::Point>>,
+    ) {
+        let terminal_by_parent = capacity >= parent_bound;
+        let (bound, average) = match (self.constant, region) {
             (Some(c), _) => (self.magnitude * (c / self.mean), Some(c)),
             (None, Some(region)) if terminal_by_parent => {
                 (parent_bound, Some(self.density.average(region)))
@@ -221,7 +241,7 @@ where
             if code + 0.5 >= bound {
                 return; // not even the bound would keep it: skip the average
             }
-            let d = match (self.constant, average, &region) {
+            let d = match (self.constant, average, region) {
                 (Some(_), _, _) => self.magnitude,
                 (None, Some(a), _) => self.magnitude * (a / self.mean),
                 (None, None, Some(r)) => {
