@@ -63,7 +63,9 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    collect_parts(system, density, magnitude, None).concat()
+    let mut parts = Vec::new();
+    collect_parts(system, density, magnitude, None, &mut parts);
+    parts.concat()
 }
 
 /// A conservative test of whether a tile (its region) reaches into a window.
@@ -105,20 +107,21 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    let mut samples = Vec::new();
-    let parts = collect_parts(system, density, magnitude, Some(overlaps));
-    by_rank(parts, usize::MAX, &mut samples);
+    let (mut parts, mut samples) = (Vec::new(), Vec::new());
+    collect_parts(system, density, magnitude, Some(overlaps), &mut parts);
+    by_rank(&parts, usize::MAX, &mut samples);
     samples
 }
 
-/// The accepted samples of each root's subtree, in root order.
+/// The accepted samples of each root's subtree, in root order, into
+/// `parts` (one list per root, their memory reused).
 fn collect_parts<S, D>(
     system: &S,
     density: &D,
     magnitude: f64,
     window: Option<&Window<'_, S::Region>>,
-) -> Vec<Vec<Sample<S::Point>>>
-where
+    parts: &mut Vec<Vec<Sample<S::Point>>>,
+) where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
@@ -149,14 +152,15 @@ where
         let expected = magnitude * (average / walker.mean) / roots.len() as f64;
         (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
     };
+    parts.resize_with(roots.len(), Vec::new);
     roots
         .par_iter()
-        .map(|root| {
-            let mut out = Vec::with_capacity(share(root));
-            walker.visit(root, f64::INFINITY, &mut out);
-            out
-        })
-        .collect()
+        .zip(parts.par_iter_mut())
+        .for_each(|(root, out)| {
+            out.clear();
+            out.reserve(share(root));
+            walker.visit(root, f64::INFINITY, out);
+        });
 }
 
 /// The most samples a root's output reserves before it knows its count
@@ -333,41 +337,98 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    let mut samples = Vec::new();
-    generate_into(system, density, count, exact, &mut samples)?;
-    Ok(samples)
+    let mut buffers = Buffers::default();
+    generate_into(system, density, count, exact, &mut buffers)?;
+    Ok(buffers.into_samples())
 }
 
-/// [`generate`] into a caller's buffer: `out`'s contents are replaced and
-/// its capacity reused, so a caller drawing a new set every frame pays for
-/// fresh memory (page faults, about half the time of a large uniform
-/// request) only once.
+/// Memory a caller keeps between requests (see [`generate_into`]): the
+/// samples of the last request, and the per-root lists the recursion fills
+/// before ranking them. Fresh memory costs a page fault per 4 KB on first
+/// touch, about as much time as the sampling itself on large requests;
+/// reused buffers pay it once. They hold about twice the samples' size.
 ///
 /// # Example
 /// ```
-/// use tessera::{density::Uniform, engine, tiling::plane::PlaneTiling};
+/// use tessera::{density::plane::Ramp, engine::{self, Buffers}, tiling::plane::PlaneTiling};
 /// let tiling = PlaneTiling::ppentomino();
-/// let mut frame = Vec::new();
+/// let mut buffers = Buffers::default();
 /// for count in [1000, 500] {
-///     engine::generate_into(&tiling, &Uniform, count, true, &mut frame).unwrap();
-///     assert_eq!(frame.len(), count);
+///     let samples = engine::generate_into(&tiling, &Ramp, count, true, &mut buffers).unwrap();
+///     assert_eq!(samples.len(), count);
 /// }
+/// assert_eq!(buffers.samples().len(), 500);
 /// ```
-pub fn generate_into<S, D>(
+#[derive(Debug)]
+pub struct Buffers<P> {
+    samples: Vec<Sample<P>>,
+    parts: Vec<Vec<Sample<P>>>,
+}
+
+impl<P> Default for Buffers<P> {
+    fn default() -> Self {
+        Buffers {
+            samples: Vec::new(),
+            parts: Vec::new(),
+        }
+    }
+}
+
+impl<P> Buffers<P> {
+    /// The samples of the last request (empty after a refused one).
+    ///
+    /// # Example
+    /// ```
+    /// let buffers = tessera::engine::Buffers::<glam::DVec2>::default();
+    /// assert!(buffers.samples().is_empty());
+    /// ```
+    pub fn samples(&self) -> &[Sample<P>] {
+        &self.samples
+    }
+
+    /// The samples of the last request, keeping their memory.
+    ///
+    /// # Example
+    /// ```
+    /// let buffers = tessera::engine::Buffers::<glam::DVec2>::default();
+    /// assert!(buffers.into_samples().is_empty());
+    /// ```
+    pub fn into_samples(self) -> Vec<Sample<P>> {
+        self.samples
+    }
+}
+
+/// [`generate`] into memory kept between requests (see [`Buffers`]): for a
+/// caller drawing a new set every frame. Returns the samples, which stay in
+/// `buffers` until the next request.
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, engine::{self, Buffers}, tiling::plane::PlaneTiling};
+/// let tiling = PlaneTiling::ppentomino();
+/// let mut buffers = Buffers::default();
+/// let first = engine::generate_into(&tiling, &Uniform, 1000, true, &mut buffers).unwrap().to_vec();
+/// assert_eq!(first, engine::generate(&tiling, &Uniform, 1000, true).unwrap());
+/// ```
+pub fn generate_into<'b, S, D>(
     system: &S,
     density: &D,
     count: usize,
     exact: bool,
-    out: &mut Vec<Sample<S::Point>>,
-) -> Result<(), Error>
+    buffers: &'b mut Buffers<S::Point>,
+) -> Result<&'b [Sample<S::Point>], Error>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
+    let Buffers {
+        samples: out,
+        parts,
+    } = buffers;
     out.clear();
     if count == 0 {
-        return Ok(());
+        return Ok(out);
     }
     let mean = density.mean();
     if !(mean.is_finite() && mean > 0.0) {
@@ -385,7 +446,7 @@ where
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
         if system.code_order_samples(stream.level, count, fraction, d, out) {
-            return Ok(());
+            return Ok(out);
         }
     }
     // the safety margin of an exact request (see above)
@@ -394,10 +455,10 @@ where
     } else {
         count as f64
     };
-    let mut parts = collect_parts(system, density, magnitude, None);
+    collect_parts(system, density, magnitude, None, parts);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
-        let found = total(&parts);
+        let found = total(parts);
         if !exact || found >= count {
             break;
         }
@@ -407,31 +468,27 @@ where
             (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
         };
         magnitude *= growth;
-        parts = collect_parts(system, density, magnitude, None);
+        collect_parts(system, density, magnitude, None, parts);
     }
-    if exact && total(&parts) < count {
+    if exact && total(parts) < count {
         return Err(Error::Request(format!(
             "only {} samples fit at the deepest level; {count} were requested",
-            total(&parts)
+            total(parts)
         )));
     }
     by_rank(parts, if exact { count } else { usize::MAX }, out);
-    Ok(())
+    Ok(out)
 }
 
 /// The `keep` samples of smallest rank (all when fewer), ordered by rank,
 /// into `out` (replacing its contents); ties keep their deterministic root
 /// order (as a stable sort would).
-fn by_rank<P: Copy + Send + Sync>(
-    parts: Vec<Vec<Sample<P>>>,
-    keep: usize,
-    out: &mut Vec<Sample<P>>,
-) {
+fn by_rank<P: Copy + Send + Sync>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
     out.clear();
     let n: usize = parts.iter().map(Vec::len).sum();
     let samples = || parts.iter().flatten();
     if n < u32::MAX as usize && samples().all(|s| (0.0..1.0).contains(&s.rank)) {
-        bucket_by_rank(&parts, n, keep, out);
+        bucket_by_rank(parts, n, keep, out);
         return;
     }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in

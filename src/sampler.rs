@@ -113,18 +113,21 @@ where
         engine::generate(&self.system, &self.density, self.count, self.exact)
     }
 
-    /// [`Sampler::generate`] into a buffer whose capacity is reused (see
-    /// [`engine::generate_into`]): for a new set every frame.
+    /// [`Sampler::generate`] into memory kept between requests (see
+    /// [`engine::Buffers`]): for a new set every frame.
     ///
     /// # Example
     /// ```
     /// let sampler = tessera::Sampler::sphere().count(100);
-    /// let mut frame = Vec::new();
-    /// sampler.generate_into(&mut frame).unwrap();
-    /// assert_eq!(frame, sampler.generate().unwrap());
+    /// let mut buffers = tessera::engine::Buffers::default();
+    /// let samples = sampler.generate_into(&mut buffers).unwrap();
+    /// assert_eq!(samples, &sampler.generate().unwrap()[..]);
     /// ```
-    pub fn generate_into(&self, out: &mut Vec<Sample<S::Point>>) -> Result<(), Error> {
-        engine::generate_into(&self.system, &self.density, self.count, self.exact, out)
+    pub fn generate_into<'b>(
+        &self,
+        buffers: &'b mut engine::Buffers<S::Point>,
+    ) -> Result<&'b [Sample<S::Point>], Error> {
+        engine::generate_into(&self.system, &self.density, self.count, self.exact, buffers)
     }
 
     /// The pdf (per unit measure) the samples follow at `point`.

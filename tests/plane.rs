@@ -216,19 +216,25 @@ impl Density<PlaneRegion> for Zero {
 }
 
 #[test]
-fn a_reused_buffer_gives_what_a_fresh_one_does() {
+fn reused_buffers_give_what_fresh_ones_do() {
     for (system, tiling) in systems() {
-        let mut buffer = Vec::new();
+        let mut buffers = engine::Buffers::default();
         // growing, shrinking, and switching between the fast path and the recursion
-        for (n, ramp) in [(5000, false), (300, false), (2000, true), (8000, false)] {
+        for (n, ramp) in [
+            (5000, false),
+            (300, false),
+            (2000, true),
+            (8000, false),
+            (700, true),
+        ] {
             let density: &dyn Density<PlaneRegion> = if ramp { &Ramp } else { &Uniform };
-            engine::generate_into(&tiling, density, n, true, &mut buffer).unwrap();
+            let reused = engine::generate_into(&tiling, density, n, true, &mut buffers).unwrap();
             let fresh = engine::generate(&tiling, density, n, true).unwrap();
-            assert_eq!(buffer, fresh, "{system:?}, n = {n}, ramp {ramp}");
+            assert_eq!(reused, &fresh[..], "{system:?}, n = {n}, ramp {ramp}");
         }
         // a refused request leaves no stale samples behind
-        assert!(engine::generate_into(&tiling, &Zero, 10, true, &mut buffer).is_err());
-        assert!(buffer.is_empty());
+        assert!(engine::generate_into(&tiling, &Zero, 10, true, &mut buffers).is_err());
+        assert!(buffers.samples().is_empty());
     }
 }
 

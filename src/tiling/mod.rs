@@ -24,7 +24,7 @@ use crate::engine::Sample;
 /// ```
 pub type Code = u128;
 
-/// `code` as an f64. Codes below 2^64 (every sphere level to 28) take one
+/// `code` as an f64. Codes below 2^63 (every sphere level to 27) take one
 /// instruction; a plain `as f64` of a u128 is a library call, which the
 /// engine would pay at every tile.
 ///
@@ -43,7 +43,9 @@ pub fn code_value(code: Code) -> f64 {
     fn wide(code: Code) -> f64 {
         code as f64
     }
-    match u64::try_from(code) {
+    // through i64: x86-64 converts signed integers in one instruction,
+    // unsigned ones in several
+    match i64::try_from(code) {
         Ok(small) => small as f64,
         Err(_) => wide(code),
     }

@@ -491,11 +491,15 @@ impl TileSystem for PlaneTiling {
         let (x, y) = tile.placement.origin;
         let origin = DVec2::new(x as f64, y as f64);
         let frame = &self.frames[tile.placement.orientation.index()];
+        let mut cells = [DVec2::ZERO; MAX_CELLS];
+        for (cell, centre) in cells.iter_mut().zip(frame.centres) {
+            *cell = (origin + centre) * s;
+        }
         PlaneRegion {
             lo: (origin + frame.lo) * s,
             hi: (origin + frame.hi) * s,
             cell: s,
-            cells: frame.centres.map(|centre| (origin + centre) * s),
+            cells,
             count: frame.count,
         }
     }
