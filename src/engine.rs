@@ -522,7 +522,9 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
         return;
     };
     let buckets = n.max(1);
-    let bucket = |s: &Sample<P>| ((s.rank * buckets as f64) as usize).min(buckets - 1);
+    // (`n` < 2^32, so the bucket fits u32, whose conversion is the cheaper)
+    let (scale, last) = (buckets as f64, buckets as u32 - 1);
+    let bucket = |s: &Sample<P>| ((s.rank * scale) as u32).min(last) as usize;
     let groups = buckets.div_ceil(GROUP_BUCKETS);
     let mut start = vec![0usize; groups + 1];
     for s in parts.iter().flatten() {
