@@ -255,34 +255,86 @@ where
                     unreachable!("a region exists whenever the density varies")
                 }
             };
-            // a tile's code threshold sits mid-way through its unit of
-            // density, so sparse regions round instead of always keeping code 0
-            if d.is_nan() || code + 0.5 >= d {
-                return;
-            }
-            let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
-                return; // the tiling reaches past the domain there
-            };
-            // an offset may carry a sample off the support of a partly lit
-            // tile (a map lit in one pixel): then the tile's children place
-            // it, the one sharing its code (and lit) keeping it
-            let off_support = self.constant.is_none() && {
-                let value = self.density.value(position);
-                value.is_nan() || value <= 0.0
-            };
-            if !off_support {
-                out.push(Sample {
-                    position,
-                    rank: code / d,
-                });
-                return;
-            }
-            // a single child (a Penrose point) would only re-place the
-            // same sample: drop it, as the domain's edge does
-            if level >= self.system.max_level() || self.system.child_count(tile) <= 1 {
+            if self.emit(tile, level, capacity, code, d, out) {
                 return;
             }
         }
+        self.visit_children(tile, level, bound, out);
+    }
+
+    /// A child whose parent's bound makes it terminal and does not reject
+    /// its code (`code`): [`Walker::decide`]'s terminal step without the
+    /// tests the parent made.
+    fn visit_terminal(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        code: f64,
+        bound: f64,
+        out: &mut Vec<Sample<S::Point>>,
+    ) {
+        if self.window.is_some() || !self.system.carries_sample(tile) {
+            return self.visit(tile, bound, out);
+        }
+        let d = match self.constant {
+            Some(_) => self.magnitude,
+            None => self.magnitude * (self.density.average(&self.system.region(tile)) / self.mean),
+        };
+        let capacity = self.capacities[level as usize];
+        if !self.emit(tile, level, capacity, code, d, out) {
+            self.visit_children(tile, level, bound, out);
+        }
+    }
+
+    /// Places the sample of a terminal tile of code `code` at density `d`
+    /// (code units), if its code keeps it. True when done; false when the
+    /// sample fell off the density's support and the tile's children must
+    /// place it instead.
+    #[inline(always)]
+    fn emit(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        capacity: f64,
+        code: f64,
+        d: f64,
+        out: &mut Vec<Sample<S::Point>>,
+    ) -> bool {
+        // a tile's code threshold sits mid-way through its unit of
+        // density, so sparse regions round instead of always keeping code 0
+        if d.is_nan() || code + 0.5 >= d {
+            return true;
+        }
+        let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
+            return true; // the tiling reaches past the domain there
+        };
+        // an offset may carry a sample off the support of a partly lit
+        // tile (a map lit in one pixel): then the tile's children place
+        // it, the one sharing its code (and lit) keeping it
+        let off_support = self.constant.is_none() && {
+            let value = self.density.value(position);
+            value.is_nan() || value <= 0.0
+        };
+        if !off_support {
+            out.push(Sample {
+                position,
+                rank: code / d,
+            });
+            return true;
+        }
+        // a single child (a Penrose point) would only re-place the
+        // same sample: drop it, as the domain's edge does
+        level >= self.system.max_level() || self.system.child_count(tile) <= 1
+    }
+
+    /// Visits the children of a tile whose scaled bound is `bound`.
+    fn visit_children(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        bound: f64,
+        out: &mut Vec<Sample<S::Point>>,
+    ) {
         // children the bound already rejects (see `visit`'s first test) are
         // skipped before they are built; in code order, the first such child
         // ends the loop
@@ -293,10 +345,11 @@ where
                 let Some(i) = self.system.child_by_code_rank(tile, rank) else {
                     break;
                 };
-                if code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
+                let code = code_value(self.system.child_code(tile, i));
+                if code + 0.5 >= bound {
                     break;
                 }
-                self.visit(&self.system.child(tile, i), bound, out);
+                self.visit_terminal(&self.system.child(tile, i), level + 1, code, bound, out);
             }
             return;
         }
