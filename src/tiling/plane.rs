@@ -492,7 +492,7 @@ impl TileSystem for PlaneTiling {
         let origin = DVec2::new(x as f64, y as f64);
         let frame = &self.frames[tile.placement.orientation.index()];
         let mut cells = [DVec2::ZERO; MAX_CELLS];
-        for (cell, centre) in cells.iter_mut().zip(frame.centres) {
+        for (cell, &centre) in cells.iter_mut().zip(&frame.centres) {
             *cell = (origin + centre) * s;
         }
         PlaneRegion {
