@@ -14,6 +14,10 @@
 //!             else emit(p, rank = code / d)
 //!     else: visit every child
 //! ```
+//! Children are skipped on their code alone when `b` makes them terminal
+//! and rejects them; systems that know their children's code order
+//! ([`TileSystem::child_by_code_rank`]) are visited in it, stopping at the
+//! first child `b` rejects.
 //! Tiles that carry no sample (Penrose's triangles) stop at the terminal
 //! test, and a sample the system places outside its domain is dropped
 //! ([`TileSystem::sample_in_domain`]).
@@ -23,7 +27,8 @@
 //! 1e-300..1e300, subnormals included, from overflowing). Ranks order the output progressively: the samples with rank
 //! below `s` are those an `s`-times smaller request accepts, so every prefix
 //! of the output is itself a well-spread set. The roots are visited in parallel and
-//! gathered in order, so the output does not depend on the thread count.
+//! gathered in order, so the output does not depend on the thread count;
+//! a counting sort on the rank then orders them (ties in root order).
 
 use crate::density::{Density, Region};
 use crate::tiling::{code_value, Code, TileSystem};
