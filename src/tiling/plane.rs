@@ -122,8 +122,9 @@ pub struct PlaneTiling {
     inv_size: Vec<f64>,
     /// The shape's cells and bounding box in each of the 8 orientations.
     frames: [Frame; 8],
-    /// The fractions the bins were optimised for, increasing, widened by a
-    /// relative tolerance that keeps exact bin fractions in their own bin.
+    /// The bin edges of [`PlaneTiling::bin`], widened by its tolerance and
+    /// padded with infinities to a power of two longer than `bins`, for a
+    /// branch-free binary search.
     bin_edges: Vec<f64>,
 }
 
@@ -207,8 +208,12 @@ impl PlaneTiling {
         let offsets = (0..lut.classes() * lut.bins as usize)
             .map(|k| lut.offset(k / lut.bins as usize, k % lut.bins as usize))
             .collect();
-        let bin_edges = (0..lut.bins as usize)
-            .map(|b| lut.bin_fraction(b) * (1.0 + 1e-9))
+        // a relative tolerance keeps exact bin fractions in their own bin
+        let bin_edges = (0..(lut.bins as usize + 1).next_power_of_two())
+            .map(|b| match b < lut.bins as usize {
+                true => lut.bin_fraction(b) * (1.0 + 1e-9),
+                false => f64::INFINITY,
+            })
             .collect();
         let mut roots_by_code: Vec<PlaneTile> = (0..lut.roots.len())
             .map(|r| PlaneTile {
@@ -386,7 +391,16 @@ impl PlaneTiling {
     /// ```
     #[inline]
     pub fn bin(&self, fraction: f64) -> usize {
-        let below = self.bin_edges.partition_point(|&edge| edge < fraction);
+        // the number of edges below `fraction`, found by halving steps:
+        // every edge before `below` lies below it
+        let mut below = 0;
+        let mut step = self.bin_edges.len() / 2;
+        while step > 0 {
+            if self.bin_edges[below + step - 1] < fraction {
+                below += step;
+            }
+            step /= 2;
+        }
         below.min(self.bins - 1)
     }
 
