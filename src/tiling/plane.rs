@@ -124,7 +124,8 @@ pub struct PlaneTiling {
     frames: [Frame; 8],
     /// The bin edges of [`PlaneTiling::bin`], widened by its tolerance and
     /// padded with infinities to a power of two longer than `bins`, for a
-    /// branch-free binary search.
+    /// binary search of a fixed number of halving steps (ramp requests ran
+    /// about 20 % slower with `partition_point`, in interleaved runs).
     bin_edges: Vec<f64>,
 }
 
