@@ -307,11 +307,7 @@ fn output_is_progressive_and_deterministic() {
     }
     assert_eq!(points, positions(&t, &Uniform, 4096));
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let u = engine::generate(&t, &Uniform, 30_000, true).unwrap();
             let r = engine::generate(&t, &Ramp, 5_000, true).unwrap();
             (u, r)

@@ -164,11 +164,7 @@ fn output_is_progressive() {
 #[test]
 fn one_and_two_threads_give_the_same_samples() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             systems()
                 .iter()
                 .map(|(_, t)| {

@@ -4,6 +4,7 @@
 //! counts, tile membership, determinism, thread independence and
 //! progressive prefixes.
 
+mod common;
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 use std::f64::consts::{PI, TAU};
@@ -188,11 +189,9 @@ fn normalised_separation(map: &EnvMap, points: &[DVec3]) -> f64 {
 }
 
 fn generate_with_threads(map: &EnvMap, n: usize, threads: usize) -> Vec<Sample<DVec3>> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| engine::generate(&SphereTiling::default(), map, n, true).unwrap())
+    common::on_threads(threads, || {
+        engine::generate(&SphereTiling::default(), map, n, true).unwrap()
+    })
 }
 
 proptest! {
@@ -334,11 +333,9 @@ fn generate_planar(
     n: usize,
     threads: usize,
 ) -> Vec<Sample<DVec2>> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| engine::generate(tiling, raster, n, true).unwrap())
+    common::on_threads(threads, || {
+        engine::generate(tiling, raster, n, true).unwrap()
+    })
 }
 
 /// Smallest `distance * sqrt(n * density)` over pairs, the density being

@@ -1,5 +1,6 @@
 //! The sphere tile system and sampler: geometry, codes, counts, determinism.
 
+mod common;
 use approx::assert_relative_eq;
 use glam::DVec3;
 use proptest::prelude::*;
@@ -126,11 +127,7 @@ fn full_levels_put_one_point_in_each_pentomino() {
 fn output_is_deterministic_and_independent_of_threads() {
     let cap = Cap::new(30.0, 10.0, 25.0, 40.0).unwrap();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             Sampler::sphere()
                 .density(cap)
                 .count(5000)
