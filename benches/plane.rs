@@ -7,7 +7,8 @@
 //! iterations (`engine::generate_into` with `engine::Buffers`, what a
 //! renderer drawing a set per frame pays). `fresh_buffer_write_only` writes
 //! `N` samples into a fresh `Vec` with no sampling at all: the floor of the
-//! first kind.
+//! first kind. On the ramp, `_unsorted` asks for the same samples without
+//! the ranking sort (`engine::Order::Unsorted`).
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
@@ -15,7 +16,7 @@ use glam::DVec2;
 use std::hint::black_box;
 use tessera::baselines::bridson;
 use tessera::density::{plane::Ramp, Density, Uniform};
-use tessera::engine::{self, Sample};
+use tessera::engine::{self, Order, Sample};
 use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::{PlaneRegion, PlaneTiling};
 use tessera::tiling::TileSystem;
@@ -53,13 +54,20 @@ fn uniform_and_ramp<S>(
             b.iter(|| pool.install(|| black_box(engine::generate(tiling, density, N, true))))
         });
         let mut buffers = engine::Buffers::default();
-        group.bench_function(format!("{name}_{density_name}_reused_buffers"), |b| {
-            b.iter(|| {
-                let samples =
-                    pool.install(|| engine::generate_into(tiling, density, N, true, &mut buffers));
-                black_box(samples.expect("samples").len())
-            })
-        });
+        let orders = [("", Order::Progressive), ("_unsorted", Order::Unsorted)];
+        // (the uniform fast path comes out in rank order either way)
+        let kept = if density_name == "ramp" { 2 } else { 1 };
+        for (order_name, order) in &orders[..kept] {
+            let id = format!("{name}_{density_name}{order_name}_reused_buffers");
+            group.bench_function(id, |b| {
+                b.iter(|| {
+                    let samples = pool.install(|| {
+                        engine::generate_into(tiling, density, N, true, *order, &mut buffers)
+                    });
+                    black_box(samples.expect("samples").len())
+                })
+            });
+        }
     }
 }
 

@@ -396,7 +396,14 @@ where
     D: Density<S::Region> + ?Sized,
 {
     let mut buffers = Buffers::default();
-    generate_into(system, density, count, exact, &mut buffers)?;
+    generate_into(
+        system,
+        density,
+        count,
+        exact,
+        Order::Progressive,
+        &mut buffers,
+    )?;
     Ok(buffers.into_samples())
 }
 
@@ -408,11 +415,12 @@ where
 ///
 /// # Example
 /// ```
-/// use tessera::{density::plane::Ramp, engine::{self, Buffers}, tiling::plane::PlaneTiling};
+/// use tessera::{density::plane::Ramp, engine::{self, Buffers, Order}, tiling::plane::PlaneTiling};
 /// let tiling = PlaneTiling::ppentomino();
 /// let mut buffers = Buffers::default();
 /// for count in [1000, 500] {
-///     let samples = engine::generate_into(&tiling, &Ramp, count, true, &mut buffers).unwrap();
+///     let samples = engine::generate_into(&tiling, &Ramp, count, true, Order::Progressive, &mut buffers)
+///         .unwrap();
 ///     assert_eq!(samples.len(), count);
 /// }
 /// assert_eq!(buffers.samples().len(), 500);
@@ -456,16 +464,45 @@ impl<P> Buffers<P> {
     }
 }
 
-/// [`generate`] into memory kept between requests (see [`Buffers`]): for a
-/// caller drawing a new set every frame. Returns the samples, which stay in
-/// `buffers` until the next request.
+/// The order a request's samples come out in.
 ///
 /// # Example
 /// ```
-/// use tessera::{density::Uniform, engine::{self, Buffers}, tiling::plane::PlaneTiling};
+/// use tessera::{density::plane::Ramp, engine::{self, Buffers, Order}, tiling::plane::PlaneTiling};
 /// let tiling = PlaneTiling::ppentomino();
 /// let mut buffers = Buffers::default();
-/// let first = engine::generate_into(&tiling, &Uniform, 1000, true, &mut buffers).unwrap().to_vec();
+/// let mut any = engine::generate_into(&tiling, &Ramp, 500, true, Order::Unsorted, &mut buffers)
+///     .unwrap().to_vec();
+/// any.sort_by(|a, b| a.rank.total_cmp(&b.rank));
+/// assert_eq!(any, engine::generate(&tiling, &Ramp, 500, true).unwrap());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Order {
+    /// By rank: every prefix is itself a well-spread set, as a smaller
+    /// request would give.
+    #[default]
+    Progressive,
+    /// The same samples in whatever order is cheapest to produce (today:
+    /// the recursion's tile order, depth first, roots in order, which is
+    /// spatially coherent; or rank order where that is what comes out).
+    /// It skips the ranking sort, about a third of a large request's time,
+    /// for callers that use the whole set. Deterministic, and independent
+    /// of the thread count.
+    Unsorted,
+}
+
+/// [`generate`] into memory kept between requests (see [`Buffers`]): for a
+/// caller drawing a new set every frame, in the given `order`. Returns the
+/// samples, which stay in `buffers` until the next request.
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, engine::{self, Buffers, Order}, tiling::plane::PlaneTiling};
+/// let tiling = PlaneTiling::ppentomino();
+/// let mut buffers = Buffers::default();
+/// let first = engine::generate_into(&tiling, &Uniform, 1000, true, Order::Progressive, &mut buffers)
+///     .unwrap()
+///     .to_vec();
 /// assert_eq!(first, engine::generate(&tiling, &Uniform, 1000, true).unwrap());
 /// ```
 pub fn generate_into<'b, S, D>(
@@ -473,6 +510,7 @@ pub fn generate_into<'b, S, D>(
     density: &D,
     count: usize,
     exact: bool,
+    order: Order,
     buffers: &'b mut Buffers<S::Point>,
 ) -> Result<&'b [Sample<S::Point>], Error>
 where
@@ -534,8 +572,64 @@ where
             total(parts)
         )));
     }
-    by_rank(parts, if exact { count } else { usize::MAX }, out);
+    let keep = if exact { count } else { usize::MAX };
+    match order {
+        Order::Progressive => by_rank(parts, keep, out),
+        Order::Unsorted => smallest_ranks(parts, keep, out),
+    }
     Ok(out)
+}
+
+/// The `keep` samples of smallest rank (all when fewer) in root order,
+/// into `out` (replacing its contents): the set [`by_rank`] keeps, ties
+/// included, without sorting it. A histogram of the ranks finds the bucket
+/// holding the cut, only that bucket's samples (a few dozen) are sorted,
+/// and one pass copies the kept ones.
+fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
+    out.clear();
+    let n: usize = parts.iter().map(Vec::len).sum();
+    if keep == 0 {
+        return;
+    }
+    if keep >= n {
+        for part in parts {
+            out.extend_from_slice(part);
+        }
+        return;
+    }
+    let samples = || parts.iter().flatten().enumerate();
+    // about 32 samples a bucket; monotone in the rank (as `by_rank`'s
+    // buckets are), ranks outside [0, 1) going to the end buckets
+    let buckets = (n / 32).clamp(16, 1 << 16);
+    let scale = buckets as f64;
+    let bucket = |rank: f64| ((rank * scale) as usize).min(buckets - 1);
+    let mut counts = vec![0usize; buckets];
+    for (_, s) in samples() {
+        counts[bucket(s.rank)] += 1;
+    }
+    // every bucket below `cut` is kept whole; `below` samples are in them
+    let (mut cut, mut below) = (0, 0);
+    while below + counts[cut] < keep {
+        below += counts[cut];
+        cut += 1;
+    }
+    let mut candidates: Vec<(f64, usize)> = samples()
+        .filter(|(_, s)| bucket(s.rank) == cut)
+        .map(|(i, s)| (s.rank, i))
+        .collect();
+    let order = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    candidates.sort_by(order);
+    // the last kept sample of the cut's bucket (it keeps at least one)
+    let last = candidates[keep - below - 1];
+    out.reserve(keep);
+    out.extend(
+        samples()
+            .filter(|&(i, s)| {
+                let b = bucket(s.rank);
+                b < cut || (b == cut && order(&(s.rank, i), &last).is_le())
+            })
+            .map(|(_, s)| *s),
+    );
 }
 
 /// The `keep` samples of smallest rank (all when fewer), ordered by rank,
@@ -796,7 +890,8 @@ mod tests {
 
     proptest! {
         /// Ranking equals a stable sort of the concatenated parts by rank,
-        /// truncated: across groups, with ties (few distinct ranks) and
+        /// truncated, and the unsorted selection keeps the same samples in
+        /// root order: across groups, with ties (few distinct ranks) and
         /// with keep below, at and above the count.
         #[test]
         fn ranking_is_a_stable_sort_by_rank(
@@ -829,7 +924,13 @@ mod tests {
             expected.truncate(keep);
             let mut out = vec![Sample { position: 0, rank: 0.5 }; 3];
             by_rank(&parts, keep, &mut out);
-            prop_assert_eq!(out, expected);
+            prop_assert_eq!(&out, &expected);
+            // unsorted: the same samples, in root order
+            let mut unsorted = vec![Sample { position: 0, rank: 0.5 }; 3];
+            smallest_ranks(&parts, keep, &mut unsorted);
+            prop_assert!(unsorted.windows(2).all(|w| w[0].position < w[1].position));
+            unsorted.sort_by(|a, b| a.rank.total_cmp(&b.rank).then(a.position.cmp(&b.position)));
+            prop_assert_eq!(unsorted, expected);
         }
     }
 }

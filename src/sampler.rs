@@ -1,7 +1,7 @@
 //! The builder most users start from.
 
 use crate::density::{Density, Region, Uniform};
-use crate::engine::{self, Sample};
+use crate::engine::{self, Order, Sample};
 use crate::tiling::sphere::SphereTiling;
 use crate::tiling::TileSystem;
 use crate::Error;
@@ -20,6 +20,7 @@ pub struct Sampler<S, D> {
     density: D,
     count: usize,
     exact: bool,
+    order: Order,
 }
 
 impl Sampler<SphereTiling, Uniform> {
@@ -50,6 +51,7 @@ impl<S: TileSystem> Sampler<S, Uniform> {
             density: Uniform,
             count: 0,
             exact: true,
+            order: Order::Progressive,
         }
     }
 }
@@ -74,6 +76,7 @@ where
             density,
             count: self.count,
             exact: self.exact,
+            order: self.order,
         }
     }
 
@@ -102,7 +105,22 @@ where
         self
     }
 
-    /// Runs the recursion; samples come in progressive order.
+    /// Sets the order of the output (progressive by default; see
+    /// [`Order`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{engine::Order, Sampler};
+    /// let s = Sampler::sphere().count(100).order(Order::Unsorted).generate().unwrap();
+    /// assert_eq!(s.len(), 100);
+    /// ```
+    pub fn order(mut self, order: Order) -> Self {
+        self.order = order;
+        self
+    }
+
+    /// Runs the recursion; samples come in the sampler's order
+    /// (progressive unless [`Sampler::order`] says otherwise).
     ///
     /// # Example
     /// ```
@@ -110,7 +128,9 @@ where
     /// assert!(s.windows(2).all(|w| w[0].rank <= w[1].rank));
     /// ```
     pub fn generate(&self) -> Result<Vec<Sample<S::Point>>, Error> {
-        engine::generate(&self.system, &self.density, self.count, self.exact)
+        let mut buffers = engine::Buffers::default();
+        self.generate_into(&mut buffers)?;
+        Ok(buffers.into_samples())
     }
 
     /// [`Sampler::generate`] into memory kept between requests (see
@@ -127,7 +147,14 @@ where
         &self,
         buffers: &'b mut engine::Buffers<S::Point>,
     ) -> Result<&'b [Sample<S::Point>], Error> {
-        engine::generate_into(&self.system, &self.density, self.count, self.exact, buffers)
+        engine::generate_into(
+            &self.system,
+            &self.density,
+            self.count,
+            self.exact,
+            self.order,
+            buffers,
+        )
     }
 
     /// The pdf (per unit measure) the samples follow at `point`.
@@ -187,7 +214,10 @@ where
         rect: &crate::density::rectangle::Rectangle,
     ) -> Result<Vec<Sample<glam::DVec2>>, Error> {
         let density = rect.restrict(&self.density);
-        let mut samples = engine::generate(&self.system, &density, self.count, self.exact)?;
+        let mut buffers = engine::Buffers::default();
+        let (count, exact, order) = (self.count, self.exact, self.order);
+        engine::generate_into(&self.system, &density, count, exact, order, &mut buffers)?;
+        let mut samples = buffers.into_samples();
         for s in &mut samples {
             s.position = rect.to_world(s.position);
         }

@@ -10,9 +10,10 @@ use proptest::prelude::*;
 use tessera::baselines::SplitMix64;
 use tessera::density::plane::{Ramp, Raster};
 use tessera::density::{Density, Uniform};
-use tessera::engine;
+use tessera::engine::{self, Order};
 use tessera::lut::{plane_lut, PlaneLut, PlaneSystem};
 use tessera::metrics::plane::{low_frequency_power, min_distance, spectral_peaks};
+use tessera::tiling::penrose::PenroseTiling;
 use tessera::tiling::plane::{PlaneRegion, PlaneTiling, MAX_LATTICE_SIDE};
 use tessera::tiling::{Code, TileSystem};
 
@@ -224,13 +225,79 @@ fn reused_buffers_give_what_fresh_ones_do() {
             (700, true),
         ] {
             let density: &dyn Density<PlaneRegion> = if ramp { &Ramp } else { &Uniform };
-            let reused = engine::generate_into(&tiling, density, n, true, &mut buffers).unwrap();
+            let reused =
+                engine::generate_into(&tiling, density, n, true, Order::Progressive, &mut buffers)
+                    .unwrap();
             let fresh = engine::generate(&tiling, density, n, true).unwrap();
             assert_eq!(reused, &fresh[..], "{system:?}, n = {n}, ramp {ramp}");
         }
         // a refused request leaves no stale samples behind
-        assert!(engine::generate_into(&tiling, &Zero, 10, true, &mut buffers).is_err());
+        assert!(
+            engine::generate_into(&tiling, &Zero, 10, true, Order::Progressive, &mut buffers)
+                .is_err()
+        );
         assert!(buffers.samples().is_empty());
+    }
+}
+
+/// An unsorted request keeps exactly the samples of a progressive one
+/// (ties included), in an order that does not depend on the thread count.
+#[test]
+fn unsorted_requests_keep_the_progressive_samples() {
+    let photo = Raster::new(96, 64, photograph(96, 64, 3), false).unwrap();
+    let densities: [(&str, &dyn Density<PlaneRegion>); 3] = [
+        ("uniform", &Uniform),
+        ("ramp", &Ramp),
+        ("photograph", &photo),
+    ];
+    for (name, density) in densities {
+        for (system, tiling) in systems() {
+            unsorted_keeps_the_progressive_samples(
+                &tiling,
+                density,
+                &format!("{system:?}, {name}"),
+            );
+        }
+        unsorted_keeps_the_progressive_samples(
+            &PenroseTiling::default(),
+            density,
+            &format!("penrose, {name}"),
+        );
+    }
+}
+
+fn unsorted_keeps_the_progressive_samples<S>(
+    tiling: &S,
+    density: &dyn Density<PlaneRegion>,
+    name: &str,
+) where
+    S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+{
+    let run = |n, exact, order| {
+        let mut buffers = engine::Buffers::default();
+        let samples = engine::generate_into(tiling, density, n, exact, order, &mut buffers);
+        samples.unwrap().to_vec()
+    };
+    // ties in rank make the progressive order depend on root order: compare as sets
+    let by_rank_then_place = |mut s: Vec<engine::Sample<DVec2>>| {
+        s.sort_by(|a, b| {
+            (a.rank.total_cmp(&b.rank))
+                .then(a.position.x.total_cmp(&b.position.x))
+                .then(a.position.y.total_cmp(&b.position.y))
+        });
+        s
+    };
+    for (n, exact) in [(1, true), (3000, true), (3000, false), (20_000, true)] {
+        let progressive = run(n, exact, Order::Progressive);
+        let unsorted = common::on_threads(1, || run(n, exact, Order::Unsorted));
+        let on_two = common::on_threads(2, || run(n, exact, Order::Unsorted));
+        let at = format!("{name}, n = {n}, exact {exact}");
+        assert_eq!(unsorted, on_two, "{at}");
+        assert_eq!(
+            by_rank_then_place(unsorted),
+            by_rank_then_place(progressive),
+            "{at}"
+        );
     }
 }
 
@@ -394,6 +461,24 @@ fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
             let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
             assert!(v.len() == 2 && in_domain(&DVec2::new(v[0], v[1])));
         }
+        // --unsorted: the same lines in another order
+        let args = [
+            "plane",
+            "--system",
+            system,
+            "--density",
+            "ramp",
+            "-n",
+            "300",
+        ];
+        let unsorted = tessera(&[&args[..], &["--unsorted"]].concat()).stdout;
+        let unsorted = String::from_utf8(unsorted).unwrap();
+        assert_ne!(unsorted, text);
+        let (mut a, mut b): (Vec<&str>, Vec<&str>) =
+            (text.lines().collect(), unsorted.lines().collect());
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b);
         let bin = tessera(&["plane", "--system", system, "-n", "7", "--format", "bin"]).stdout;
         assert_eq!(bin.len(), 20 + 7 * 16);
         let rows = tessera::io::points::read_points_from(&bin[..], 2, "stdout").unwrap();

@@ -6,8 +6,11 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tessera::density::sphere::Cap;
+use tessera::density::{Density, Region};
+use tessera::engine::{Order, Sample};
 use tessera::io::points::SphereFormat;
 use tessera::tiling::sphere::SphereTiling;
+use tessera::tiling::TileSystem;
 use tessera::{engine, Error};
 
 #[derive(Parser)]
@@ -133,9 +136,39 @@ struct RequestArgs {
     /// Skip the exactness pass: return the natural count near N.
     #[arg(long)]
     expected: bool,
+    /// Write the same samples in tile order instead of progressive order
+    /// (skips the ranking sort; a prefix of the file is then not well spread).
+    #[arg(long)]
+    unsorted: bool,
     /// Output file, `-` for standard output.
     #[arg(short, long, default_value = "-")]
     output: PathBuf,
+}
+
+impl RequestArgs {
+    /// The samples this request asks for from `system` under `density`.
+    fn generate<S, D>(&self, system: &S, density: &D) -> Result<Vec<Sample<S::Point>>, Error>
+    where
+        S: TileSystem,
+        S::Region: Region<Point = S::Point>,
+        D: Density<S::Region> + ?Sized,
+    {
+        let order = if self.unsorted {
+            Order::Unsorted
+        } else {
+            Order::Progressive
+        };
+        let mut buffers = engine::Buffers::default();
+        engine::generate_into(
+            system,
+            density,
+            self.count,
+            !self.expected,
+            order,
+            &mut buffers,
+        )?;
+        Ok(buffers.into_samples())
+    }
 }
 
 #[derive(Args)]
@@ -401,12 +434,7 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
         _ => {
-            let samples = engine::generate(
-                &tiling,
-                &*density,
-                args.request.count,
-                !args.request.expected,
-            )?;
+            let samples = args.request.generate(&tiling, &*density)?;
             let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
             if args.report {
                 print_report(&points);
@@ -453,7 +481,7 @@ fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<()
         None => map,
     };
     let tiling = SphereTiling::default();
-    let samples = engine::generate(&tiling, &map, args.request.count, !args.request.expected)?;
+    let samples = args.request.generate(&tiling, &map)?;
     let points: Vec<glam::DVec3> = samples.iter().map(|s| map.to_world(s.position)).collect();
     if args.report {
         eprintln!("tessera: {name}: integral {} (value x sr)", map.integral());
@@ -505,7 +533,7 @@ where
         .as_deref()
         .map(tessera::density::rectangle::Rectangle::parse)
         .transpose()?;
-    let (count, exact) = (args.request.count, !args.request.expected);
+    let count = args.request.count;
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(tiling, count) {
         // large uniform requests stream: memory stays O(depth)
@@ -514,11 +542,13 @@ where
         }
         _ => {
             let points: Vec<glam::DVec2> = match rect {
-                Some(rect) => engine::generate(tiling, &rect.restrict(&*density), count, exact)?
+                Some(rect) => (args.request.generate(tiling, &rect.restrict(&*density)))?
                     .iter()
                     .map(|s| rect.to_world(s.position))
                     .collect(),
-                None => engine::generate(tiling, &*density, count, exact)?
+                None => args
+                    .request
+                    .generate(tiling, &*density)?
                     .iter()
                     .map(|s| s.position)
                     .collect(),
