@@ -375,7 +375,8 @@ fn bins_are_the_first_optimised_for_at_least_the_fraction() {
                 .count();
             below.min(bins - 1)
         };
-        let mut fractions = vec![0.0, 1e-300, 1e-9, 0.3, 0.5, 1.0, 1.5, f64::NAN];
+        let mut fractions = vec![0.0, -0.0, -0.5, 1e-300, 1e-9, 0.3, 0.5, 1.0, 1.5, 1e300];
+        fractions.extend([f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
         for b in 0..bins {
             let f = lut.bin_fraction(b);
             fractions.extend([f, f * (1.0 + 1e-12), f * (1.0 + 2e-9), f * (1.0 - 1e-12)]);
