@@ -708,8 +708,8 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
     }
     slices
         .into_par_iter()
-        .for_each_init(Vec::new, |scratch, (first_bucket, group)| {
-            sort_group(group, first_bucket, &bucket, scratch);
+        .for_each_init(Default::default, |scratch, (first_bucket, group)| {
+            sort_group(group, first_bucket, bucket, scratch);
         });
     out.truncate(keep);
 }
@@ -720,36 +720,46 @@ const GROUP_BUCKETS: usize = 8192;
 
 /// Sorts `group`, whose samples fall in buckets `first_bucket..` (fewer
 /// than [`GROUP_BUCKETS`] of them), by rank: a stable counting sort by
-/// bucket through `scratch`, then a stable sort of each bucket.
+/// bucket through `scratch` (each sample's bucket computed once, into
+/// `local`), then a stable sort of each bucket holding several.
 fn sort_group<P: Copy>(
     group: &mut [Sample<P>],
     first_bucket: usize,
-    bucket: &impl Fn(&Sample<P>) -> usize,
-    scratch: &mut Vec<Sample<P>>,
+    bucket: impl Fn(&Sample<P>) -> usize,
+    (scratch, local): &mut (Vec<Sample<P>>, Vec<u16>),
 ) {
     let Some(&first) = group.first() else {
         return;
     };
+    local.clear();
+    local.extend(group.iter().map(|s| (bucket(s) - first_bucket) as u16));
     let mut start = [0u32; GROUP_BUCKETS + 1];
-    for s in group.iter() {
-        start[bucket(s) - first_bucket + 1] += 1;
+    for &b in local.iter() {
+        start[b as usize + 1] += 1;
     }
     for b in 0..GROUP_BUCKETS {
         start[b + 1] += start[b];
     }
     scratch.clear();
     scratch.resize(group.len(), first);
-    for s in group.iter() {
-        let b = bucket(s) - first_bucket;
-        scratch[start[b] as usize] = *s;
-        start[b] += 1;
+    for (s, &b) in group.iter().zip(local.iter()) {
+        let at = &mut start[b as usize];
+        scratch[*at as usize] = *s;
+        *at += 1;
     }
-    // `start[b]` is now the end of bucket b
+    // `start[b]` is now the end of bucket b; most hold one sample, a
+    // quarter two or more
     let mut lo = 0;
     for &hi in &start[..GROUP_BUCKETS] {
         let hi = hi as usize;
-        if hi - lo > 1 {
-            scratch[lo..hi].sort_by(|a, b| a.rank.total_cmp(&b.rank));
+        match hi - lo {
+            0 | 1 => {}
+            2 => {
+                if scratch[lo + 1].rank.total_cmp(&scratch[lo].rank).is_lt() {
+                    scratch.swap(lo, lo + 1);
+                }
+            }
+            _ => scratch[lo..hi].sort_by(|a, b| a.rank.total_cmp(&b.rank)),
         }
         lo = hi;
     }
