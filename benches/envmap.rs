@@ -3,8 +3,10 @@
 //! - preprocessing: tessera's `EnvMap::new` (integral; the max pyramid is
 //!   built lazily while sampling) against building the inverse-CDF and
 //!   alias tables;
-//! - per-sample cost at N = 2^18: tessera (one thread, and two) against
-//!   i.i.d. inverse-CDF and alias sampling (one thread), in one run.
+//! - per-sample cost at N = 2^18: tessera (one thread, and two; and on one
+//!   thread with `Order::Unsorted`, which skips the progressive ranking as
+//!   the i.i.d. samplers have none) against i.i.d. inverse-CDF and alias
+//!   sampling (one thread), in one run.
 //!
 //! Run: `cargo bench --bench envmap`.
 
@@ -15,7 +17,9 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use tessera::baselines::envmap::{AliasTable, InverseCdf};
 use tessera::density::envmap::{EnvMap, Up};
+use tessera::engine::{self, Buffers, Order};
 use tessera::io::image::{read_raster, ReadOptions};
+use tessera::tiling::sphere::SphereTiling;
 
 const N: usize = 1 << 18;
 
@@ -57,6 +61,21 @@ fn per_sample(c: &mut Criterion) {
             b.iter(|| pool.install(|| black_box(map.generate(N).expect("samples"))))
         });
     }
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let sphere = SphereTiling::default();
+    group.bench_function("tessera_1_thread_unsorted", |b| {
+        b.iter(|| {
+            one.install(|| {
+                let mut buffers = Buffers::default();
+                engine::generate_into(&sphere, &map, N, true, Order::Unsorted, &mut buffers)
+                    .expect("samples");
+                black_box(buffers.into_samples())
+            })
+        })
+    });
     group.bench_function("inverse_cdf_1_thread", |b| {
         b.iter(|| black_box(inverse.samples(N, 1)))
     });
