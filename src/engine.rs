@@ -28,7 +28,8 @@
 //! below `s` are those an `s`-times smaller request accepts, so every prefix
 //! of the output is itself a well-spread set. The roots are visited in parallel and
 //! gathered in order, so the output does not depend on the thread count;
-//! a counting sort on the rank then orders them (ties in root order).
+//! a counting sort on the rank then orders them (ties in root order), or,
+//! for [`Order::Unsorted`], a histogram of the ranks only finds which to keep.
 
 use crate::density::{Density, Region};
 use crate::tiling::{code_value, Code, TileSystem};
@@ -484,7 +485,9 @@ pub enum Order {
     Progressive,
     /// The same samples in whatever order is cheapest to produce (today:
     /// the recursion's tile order, depth first, roots in order, which is
-    /// spatially coherent; or rank order where that is what comes out).
+    /// spatially coherent, but for a few dozen samples of the largest
+    /// kept ranks that come last; or rank order where that is what comes
+    /// out).
     /// It skips the ranking sort, about a third of a large request's time,
     /// for callers that use the whole set. Deterministic, and independent
     /// of the thread count.
@@ -580,11 +583,12 @@ where
     Ok(out)
 }
 
-/// The `keep` samples of smallest rank (all when fewer) in root order,
-/// into `out` (replacing its contents): the set [`by_rank`] keeps, ties
-/// included, without sorting it. A histogram of the ranks finds the bucket
-/// holding the cut, only that bucket's samples (a few dozen) are sorted,
-/// and one pass copies the kept ones.
+/// The `keep` samples of smallest rank (all when fewer), into `out`
+/// (replacing its contents): the set [`by_rank`] keeps, ties included,
+/// without sorting it. A histogram of the ranks finds the bucket holding
+/// the cut; one pass copies the samples below it in root order and sets
+/// that bucket's aside (a few dozen), of which the smallest follow, in
+/// rank order.
 fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
     out.clear();
     let n: usize = parts.iter().map(Vec::len).sum();
@@ -597,39 +601,35 @@ fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<
         }
         return;
     }
-    let samples = || parts.iter().flatten().enumerate();
     // about 32 samples a bucket; monotone in the rank (as `by_rank`'s
     // buckets are), ranks outside [0, 1) going to the end buckets
     let buckets = (n / 32).clamp(16, 1 << 16);
     let scale = buckets as f64;
     let bucket = |rank: f64| ((rank * scale) as usize).min(buckets - 1);
     let mut counts = vec![0usize; buckets];
-    for (_, s) in samples() {
+    for s in parts.iter().flatten() {
         counts[bucket(s.rank)] += 1;
     }
-    // every bucket below `cut` is kept whole; `below` samples are in them
+    // `cut` holds the `keep`-th smallest rank; `below` samples lie in the
+    // buckets before it, kept whole
     let (mut cut, mut below) = (0, 0);
     while below + counts[cut] < keep {
         below += counts[cut];
         cut += 1;
     }
-    let mut candidates: Vec<(f64, usize)> = samples()
-        .filter(|(_, s)| bucket(s.rank) == cut)
-        .map(|(i, s)| (s.rank, i))
-        .collect();
-    let order = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-    candidates.sort_by(order);
-    // the last kept sample of the cut's bucket (it keeps at least one)
-    let last = candidates[keep - below - 1];
     out.reserve(keep);
-    out.extend(
-        samples()
-            .filter(|&(i, s)| {
-                let b = bucket(s.rank);
-                b < cut || (b == cut && order(&(s.rank, i), &last).is_le())
-            })
-            .map(|(_, s)| *s),
-    );
+    // (rank, position in root order, sample) of the cut's bucket
+    let mut aside = Vec::new();
+    for (i, s) in parts.iter().flatten().enumerate() {
+        let b = bucket(s.rank);
+        if b < cut {
+            out.push(*s);
+        } else if b == cut {
+            aside.push((s.rank, i, *s));
+        }
+    }
+    aside.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    out.extend(aside[..keep - below].iter().map(|&(_, _, s)| s));
 }
 
 /// The `keep` samples of smallest rank (all when fewer), ordered by rank,
@@ -901,8 +901,9 @@ mod tests {
     proptest! {
         /// Ranking equals a stable sort of the concatenated parts by rank,
         /// truncated, and the unsorted selection keeps the same samples in
-        /// root order: across groups, with ties (few distinct ranks) and
-        /// with keep below, at and above the count.
+        /// root order (but for the last kept bucket's, in rank order at the
+        /// end): across groups, with ties (few distinct ranks) and with
+        /// keep below, at and above the count.
         #[test]
         fn ranking_is_a_stable_sort_by_rank(
             sizes in prop::collection::vec(0usize..4000, 1..6),
@@ -935,12 +936,18 @@ mod tests {
             let mut out = vec![Sample { position: 0, rank: 0.5 }; 3];
             by_rank(&parts, keep, &mut out);
             prop_assert_eq!(&out, &expected);
-            // unsorted: the same samples, in root order
+            // unsorted: the same samples, in root order but for those of
+            // the last kept one's bucket, which follow in rank order
             let mut unsorted = vec![Sample { position: 0, rank: 0.5 }; 3];
             smallest_ranks(&parts, keep, &mut unsorted);
-            prop_assert!(unsorted.windows(2).all(|w| w[0].position < w[1].position));
-            unsorted.sort_by(|a, b| a.rank.total_cmp(&b.rank).then(a.position.cmp(&b.position)));
-            prop_assert_eq!(unsorted, expected);
+            let scale = (n / 32).clamp(16, 1 << 16) as f64;
+            let bucket = |s: &Sample<u32>| (s.rank * scale) as usize;
+            // (a request keeping every sample copies them all in root order)
+            let cut = if keep >= n { usize::MAX } else { expected.last().map_or(0, bucket) };
+            let (mut head, tail): (Vec<Sample<u32>>, Vec<Sample<u32>>) =
+                expected.iter().partition(|s| bucket(s) < cut);
+            head.sort_by_key(|s| s.position);
+            prop_assert_eq!(unsorted, [head, tail].concat());
         }
     }
 }
