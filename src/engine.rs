@@ -141,6 +141,8 @@ fn collect_parts<S, D>(
         // thresholds compare codes, so the request goes in code units
         magnitude: magnitude * system.codes_per_sample(),
         mean: density.mean(),
+        per_mean: Some(magnitude * system.codes_per_sample() / density.mean())
+            .filter(|k| k.is_finite()),
         constant: density.constant(),
         window,
     };
@@ -180,6 +182,8 @@ struct Walker<'a, S: TileSystem, D: ?Sized> {
     capacities: Vec<f64>,
     magnitude: f64,
     mean: f64,
+    /// `magnitude / mean`, when finite: see [`Walker::scaled`].
+    per_mean: Option<f64>,
     constant: Option<f64>,
     /// Only tiles this accepts are visited (see [`collect_within`]).
     window: Option<&'a Window<'a, S::Region>>,
@@ -191,6 +195,19 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
+    /// A density value (a bound or an average) in code units: `value *
+    /// magnitude / mean`. One multiply where `magnitude / mean` is finite
+    /// (divisions on the chain from a tile's density to its sample's
+    /// position slowed ramp requests by about 5 %); dividing first
+    /// otherwise, so that means down to subnormals do not overflow.
+    #[inline(always)]
+    fn scaled(&self, value: f64) -> f64 {
+        match self.per_mean {
+            Some(k) => value * k,
+            None => self.magnitude * (value / self.mean),
+        }
+    }
+
     /// `parent_bound`: the parent's scaled bound, which bounds this tile
     /// too: a tile it already makes terminal needs no bound of its own (most
     /// tiles: those the recursion stops at), and one it also rejects is
@@ -236,7 +253,7 @@ where
             }
             (None, Some(region)) => {
                 let (bound, average) = self.density.bound_and_average(region);
-                (self.magnitude * (bound / self.mean), average)
+                (self.scaled(bound), average)
             }
             (None, None) => unreachable!("a region exists whenever the density varies"),
         };
@@ -253,10 +270,8 @@ where
             }
             let d = match (self.constant, average, region) {
                 (Some(_), _, _) => self.magnitude,
-                (None, Some(a), _) => self.magnitude * (a / self.mean),
-                (None, None, Some(r)) => {
-                    self.magnitude * (self.density.average_after_bound(r) / self.mean)
-                }
+                (None, Some(a), _) => self.scaled(a),
+                (None, None, Some(r)) => self.scaled(self.density.average_after_bound(r)),
                 (None, None, None) => {
                     unreachable!("a region exists whenever the density varies")
                 }
@@ -284,7 +299,7 @@ where
         }
         let d = match self.constant {
             Some(_) => self.magnitude,
-            None => self.magnitude * (self.density.average(&self.system.region(tile)) / self.mean),
+            None => self.scaled(self.density.average(&self.system.region(tile))),
         };
         let capacity = self.capacities[level as usize];
         if !self.emit(tile, level, capacity, code, d, out) {
@@ -311,7 +326,10 @@ where
         if d.is_nan() || code + 0.5 >= d {
             return true;
         }
-        let Some(position) = self.system.sample_in_domain(tile, (d / capacity).min(1.0)) else {
+        // (the reciprocal, independent of `d`, keeps the division off the
+        // chain from the density to the position)
+        let fraction = (d * (1.0 / capacity)).min(1.0);
+        let Some(position) = self.system.sample_in_domain(tile, fraction) else {
             return true; // the tiling reaches past the domain there
         };
         // an offset may carry a sample off the support of a partly lit

@@ -30,9 +30,10 @@ impl Density<PlaneRegion> for Ramp {
         region.hi.x
     }
     fn average(&self, region: &PlaneRegion) -> f64 {
-        // exact: x is linear over each cell, so its mean is the centre's x
+        // exact (to an ulp): x is linear over each cell, so its mean is the
+        // centre's x; the reciprocal keeps the division off the sum's chain
         let c = region.centres();
-        c.iter().map(|p| p.x).sum::<f64>() / c.len() as f64
+        c.iter().map(|p| p.x).sum::<f64>() * (1.0 / c.len() as f64)
     }
     fn value(&self, point: DVec2) -> f64 {
         point.x
