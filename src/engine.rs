@@ -430,7 +430,8 @@ where
 /// samples of the last request, and the per-root lists the recursion fills
 /// before ranking them. Fresh memory costs a page fault per 4 KB on first
 /// touch, about as much time as the sampling itself on large requests;
-/// reused buffers pay it once. They hold about twice the samples' size.
+/// reused buffers pay it once, and are overwritten without first being
+/// cleared. They hold about twice the samples' size.
 ///
 /// # Example
 /// ```
@@ -543,22 +544,36 @@ where
         samples: out,
         parts,
     } = buffers;
-    out.clear();
+    // the last request's samples stay in `out` until the answer overwrites
+    // them (memory already written is reused without a fill); a refused
+    // request empties it
+    let refuse = |out: &mut Vec<_>, why: String| {
+        out.clear();
+        Err(Error::Request(why))
+    };
     if count == 0 {
+        out.clear();
         return Ok(out);
     }
     let mean = density.mean();
     if !(mean.is_finite() && mean > 0.0) {
-        return Err(Error::Request(format!(
-            "the density's mean over the domain is {mean}; it must be positive and finite"
-        )));
+        return refuse(
+            out,
+            format!("the density's mean over the domain is {mean}; it must be positive and finite"),
+        );
     }
     // refuse, rather than abort on, a request whose output cannot be held
-    out.try_reserve_exact(count).map_err(|_| {
-        Error::Request(format!(
-            "{count} samples do not fit in memory; draw uniform samples with engine::stream"
-        ))
-    })?;
+    if out
+        .try_reserve_exact(count.saturating_sub(out.len()))
+        .is_err()
+    {
+        return refuse(
+            out,
+            format!(
+                "{count} samples do not fit in memory; draw uniform samples with engine::stream"
+            ),
+        );
+    }
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
@@ -588,10 +603,11 @@ where
         collect_parts(system, density, magnitude, None, parts);
     }
     if exact && total(parts) < count {
-        return Err(Error::Request(format!(
-            "only {} samples fit at the deepest level; {count} were requested",
-            total(parts)
-        )));
+        let found = total(parts);
+        return refuse(
+            out,
+            format!("only {found} samples fit at the deepest level; {count} were requested"),
+        );
     }
     let keep = if exact { count } else { usize::MAX };
     match order {
@@ -654,7 +670,6 @@ fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<
 /// into `out` (replacing its contents); ties keep their deterministic root
 /// order (as a stable sort would).
 fn by_rank<P: Copy + Send + Sync>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
-    out.clear();
     let n: usize = parts.iter().map(Vec::len).sum();
     let samples = || parts.iter().flatten();
     if n < u32::MAX as usize && samples().all(|s| (0.0..1.0).contains(&s.rank)) {
@@ -663,6 +678,7 @@ fn by_rank<P: Copy + Send + Sync>(parts: &[Vec<Sample<P>>], keep: usize, out: &m
     }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in
     // root order): distinct keys, so any sort of them is deterministic
+    out.clear();
     let samples = parts.concat();
     let mut keys: Vec<(u64, usize)> = samples
         .par_iter()
@@ -689,6 +705,7 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
     out: &mut Vec<Sample<P>>,
 ) {
     let Some(&first) = parts.iter().flatten().next() else {
+        out.clear();
         return;
     };
     let buckets = n.max(1);
@@ -706,6 +723,8 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
     // the groups holding the `keep` smallest ranks
     let used = start.partition_point(|&end| end < keep.min(n)).min(groups);
     let ends: Vec<usize> = start[1..=used].to_vec();
+    // (every slot is written below: only new memory needs a fill)
+    out.truncate(start[used]);
     out.resize(start[used], first);
     // `start[g]` moves to the end of group g while filling
     for s in parts.iter().flatten() {

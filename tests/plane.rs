@@ -216,20 +216,27 @@ impl Density<PlaneRegion> for Zero {
 fn reused_buffers_give_what_fresh_ones_do() {
     for (system, tiling) in systems() {
         let mut buffers = engine::Buffers::default();
-        // growing, shrinking, and switching between the fast path and the recursion
-        for (n, ramp) in [
-            (5000, false),
-            (300, false),
-            (2000, true),
-            (8000, false),
-            (700, true),
+        // growing, shrinking, and switching between the fast path, the
+        // recursion and the orders (the last samples stay in the buffer
+        // until overwritten)
+        for (n, ramp, order) in [
+            (5000, false, Order::Progressive),
+            (300, false, Order::Progressive),
+            (2000, true, Order::Progressive),
+            (8000, false, Order::Unsorted),
+            (700, true, Order::Progressive),
+            (9000, true, Order::Unsorted),
+            (600, true, Order::Progressive),
+            (7000, true, Order::Progressive),
         ] {
             let density: &dyn Density<PlaneRegion> = if ramp { &Ramp } else { &Uniform };
-            let reused =
-                engine::generate_into(&tiling, density, n, true, Order::Progressive, &mut buffers)
-                    .unwrap();
-            let fresh = engine::generate(&tiling, density, n, true).unwrap();
-            assert_eq!(reused, &fresh[..], "{system:?}, n = {n}, ramp {ramp}");
+            let reused = engine::generate_into(&tiling, density, n, true, order, &mut buffers)
+                .unwrap()
+                .to_vec();
+            let mut fresh_buffers = engine::Buffers::default();
+            let fresh = engine::generate_into(&tiling, density, n, true, order, &mut fresh_buffers)
+                .unwrap();
+            assert_eq!(reused, fresh, "{system:?}, n = {n}, ramp {ramp}, {order:?}");
         }
         // a refused request leaves no stale samples behind
         assert!(

@@ -586,7 +586,8 @@ impl TileSystem for PlaneTiling {
             position: DVec2::ZERO,
             rank: 0.0,
         };
-        out.clear();
+        // (every slot is written below: only new memory needs a fill)
+        out.truncate(count);
         out.resize(count, unset);
         // runs[e]: the output runs of the parents of digit `e`, one per `d`
         let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
