@@ -453,23 +453,6 @@ proptest! {
 #[test]
 fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
     for system in ["ghexomino", "ppentomino"] {
-        let out = tessera(&[
-            "plane",
-            "--system",
-            system,
-            "--density",
-            "ramp",
-            "-n",
-            "300",
-        ]);
-        assert!(out.status.success());
-        let text = String::from_utf8(out.stdout).unwrap();
-        assert_eq!(text.lines().count(), 300);
-        for line in text.lines() {
-            let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
-            assert!(v.len() == 2 && in_domain(&DVec2::new(v[0], v[1])));
-        }
-        // --unsorted: the same lines in another order
         let args = [
             "plane",
             "--system",
@@ -479,6 +462,15 @@ fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
             "-n",
             "300",
         ];
+        let out = tessera(&args);
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 300);
+        for line in text.lines() {
+            let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+            assert!(v.len() == 2 && in_domain(&DVec2::new(v[0], v[1])));
+        }
+        // --unsorted: the same lines in another order
         let unsorted = tessera(&[&args[..], &["--unsorted"]].concat()).stdout;
         let unsorted = String::from_utf8(unsorted).unwrap();
         assert_ne!(unsorted, text);
