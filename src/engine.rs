@@ -70,7 +70,7 @@ where
     D: Density<S::Region> + ?Sized,
 {
     let mut parts = Vec::new();
-    collect_parts(system, density, magnitude, None, &mut parts);
+    collect_parts(system, density, magnitude, None, &mut parts, None);
     parts.concat()
 }
 
@@ -114,19 +114,22 @@ where
     D: Density<S::Region> + ?Sized,
 {
     let (mut parts, mut samples) = (Vec::new(), Vec::new());
-    collect_parts(system, density, magnitude, Some(overlaps), &mut parts);
+    collect_parts(system, density, magnitude, Some(overlaps), &mut parts, None);
     by_rank(&parts, usize::MAX, &mut samples);
     samples
 }
 
 /// The accepted samples of each root's subtree, in root order, into
-/// `parts` (one list per root, their memory reused).
+/// `parts` (one list per root, their memory reused); with `histograms`,
+/// also each root's count of samples per rank bucket, taken while its
+/// samples are still in cache.
 fn collect_parts<S, D>(
     system: &S,
     density: &D,
     magnitude: f64,
     window: Option<&Window<'_, S::Region>>,
     parts: &mut Vec<Vec<Sample<S::Point>>>,
+    histograms: Option<(RankBuckets, &mut Vec<Vec<u32>>)>,
 ) where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
@@ -161,14 +164,53 @@ fn collect_parts<S, D>(
         (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
     };
     parts.resize_with(roots.len(), Vec::new);
+    let (buckets, mut none) = (histograms.as_ref().map(|h| h.0), Vec::new());
+    let counts = histograms.map_or(&mut none, |h| h.1);
+    counts.resize_with(roots.len(), Vec::new);
     roots
         .par_iter()
         .zip(parts.par_iter_mut())
-        .for_each(|(root, out)| {
+        .zip(counts.par_iter_mut())
+        .for_each(|((root, out), counts)| {
             out.clear();
             out.reserve(share(root));
             walker.visit(root, f64::INFINITY, out);
+            match buckets {
+                Some(buckets) => buckets.count_into(out, counts),
+                None => counts.clear(),
+            }
         });
+}
+
+/// The rank buckets of [`Order::Unsorted`]'s histograms: monotone in the
+/// rank, ranks outside [0, 1) going to the end buckets.
+#[derive(Clone, Copy)]
+struct RankBuckets {
+    count: usize,
+}
+
+impl RankBuckets {
+    /// About 32 samples a bucket for `magnitude` samples, at most 1024
+    /// (a root's histogram stays within 4 KB).
+    fn for_magnitude(magnitude: f64) -> Self {
+        RankBuckets {
+            count: ((magnitude / 32.0) as usize).clamp(16, 1024),
+        }
+    }
+
+    #[inline]
+    fn of(&self, rank: f64) -> usize {
+        ((rank * self.count as f64) as usize).min(self.count - 1)
+    }
+
+    /// The samples per bucket, into `counts` (replacing its contents).
+    fn count_into<P>(&self, samples: &[Sample<P>], counts: &mut Vec<u32>) {
+        counts.clear();
+        counts.resize(self.count, 0);
+        for s in samples {
+            counts[self.of(s.rank)] += 1;
+        }
+    }
 }
 
 /// The most samples a root's output reserves before it knows its count
@@ -449,6 +491,8 @@ where
 pub struct Buffers<P> {
     samples: Vec<Sample<P>>,
     parts: Vec<Vec<Sample<P>>>,
+    /// Per root: samples per rank bucket (unsorted requests).
+    histograms: Vec<Vec<u32>>,
 }
 
 impl<P> Default for Buffers<P> {
@@ -456,6 +500,7 @@ impl<P> Default for Buffers<P> {
         Buffers {
             samples: Vec::new(),
             parts: Vec::new(),
+            histograms: Vec::new(),
         }
     }
 }
@@ -543,6 +588,7 @@ where
     let Buffers {
         samples: out,
         parts,
+        histograms,
     } = buffers;
     // the last request's samples stay in `out` until the answer overwrites
     // them (memory already written is reused without a fill); a refused
@@ -587,7 +633,14 @@ where
     } else {
         count as f64
     };
-    collect_parts(system, density, magnitude, None, parts);
+    // an unsorted request counts ranks as each root finishes
+    let mut collect = |magnitude: f64, parts: &mut Vec<_>| {
+        let buckets = RankBuckets::for_magnitude(magnitude);
+        let counted = (order == Order::Unsorted).then_some((buckets, &mut *histograms));
+        collect_parts(system, density, magnitude, None, parts, counted);
+        buckets
+    };
+    let mut buckets = collect(magnitude, parts);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
         let found = total(parts);
@@ -600,7 +653,7 @@ where
             (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
         };
         magnitude *= growth;
-        collect_parts(system, density, magnitude, None, parts);
+        buckets = collect(magnitude, parts);
     }
     if exact && total(parts) < count {
         let found = total(parts);
@@ -612,18 +665,23 @@ where
     let keep = if exact { count } else { usize::MAX };
     match order {
         Order::Progressive => by_rank(parts, keep, out),
-        Order::Unsorted => smallest_ranks(parts, keep, out),
+        Order::Unsorted => smallest_ranks(parts, (buckets, histograms), keep, out),
     }
     Ok(out)
 }
 
 /// The `keep` samples of smallest rank (all when fewer), into `out`
 /// (replacing its contents): the set [`by_rank`] keeps, ties included,
-/// without sorting it. A histogram of the ranks finds the bucket holding
-/// the cut; one pass copies the samples below it in root order and sets
-/// that bucket's aside (a few dozen), of which the smallest follow, in
-/// rank order.
-fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
+/// without sorting it. The roots' histograms (`buckets` of each root's
+/// part) find the bucket holding the cut; one pass copies the samples
+/// below it in root order and sets that bucket's aside, of which the
+/// smallest follow, in rank order.
+fn smallest_ranks<P: Copy>(
+    parts: &[Vec<Sample<P>>],
+    (buckets, histograms): (RankBuckets, &[Vec<u32>]),
+    keep: usize,
+    out: &mut Vec<Sample<P>>,
+) {
     out.clear();
     let n: usize = parts.iter().map(Vec::len).sum();
     if keep == 0 {
@@ -635,14 +693,11 @@ fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<
         }
         return;
     }
-    // about 32 samples a bucket; monotone in the rank (as `by_rank`'s
-    // buckets are), ranks outside [0, 1) going to the end buckets
-    let buckets = (n / 32).clamp(16, 1 << 16);
-    let scale = buckets as f64;
-    let bucket = |rank: f64| ((rank * scale) as usize).min(buckets - 1);
-    let mut counts = vec![0usize; buckets];
-    for s in parts.iter().flatten() {
-        counts[bucket(s.rank)] += 1;
+    let mut counts = vec![0usize; buckets.count];
+    for histogram in histograms {
+        for (total, &c) in counts.iter_mut().zip(histogram) {
+            *total += c as usize;
+        }
     }
     // `cut` holds the `keep`-th smallest rank; `below` samples lie in the
     // buckets before it, kept whole
@@ -655,7 +710,7 @@ fn smallest_ranks<P: Copy>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<
     // (rank, position in root order, sample) of the cut's bucket
     let mut aside = Vec::new();
     for (i, s) in parts.iter().flatten().enumerate() {
-        let b = bucket(s.rank);
+        let b = buckets.of(s.rank);
         if b < cut {
             out.push(*s);
         } else if b == cut {
@@ -976,9 +1031,17 @@ mod tests {
             // unsorted: the same samples, in root order but for those of
             // the last kept one's bucket, which follow in rank order
             let mut unsorted = vec![Sample { position: 0, rank: 0.5 }; 3];
-            smallest_ranks(&parts, keep, &mut unsorted);
-            let scale = (n / 32).clamp(16, 1 << 16) as f64;
-            let bucket = |s: &Sample<u32>| (s.rank * scale) as usize;
+            let buckets = RankBuckets::for_magnitude(n as f64);
+            let histograms: Vec<Vec<u32>> = parts
+                .iter()
+                .map(|part| {
+                    let mut counts = Vec::new();
+                    buckets.count_into(part, &mut counts);
+                    counts
+                })
+                .collect();
+            smallest_ranks(&parts, (buckets, &histograms), keep, &mut unsorted);
+            let bucket = |s: &Sample<u32>| buckets.of(s.rank);
             // (a request keeping every sample copies them all in root order)
             let cut = if keep >= n { usize::MAX } else { expected.last().map_or(0, bucket) };
             let (mut head, tail): (Vec<Sample<u32>>, Vec<Sample<u32>>) =
