@@ -113,16 +113,32 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    let (mut parts, mut samples) = (Vec::new(), Vec::new());
-    collect_parts(system, density, magnitude, Some(overlaps), &mut parts, None);
-    by_rank(&parts, usize::MAX, &mut samples);
+    let (mut parts, mut samples, mut histograms) = (Vec::new(), Vec::new(), Vec::new());
+    let buckets = RankBuckets::for_magnitude(magnitude);
+    let counted = Some((buckets, &mut histograms));
+    let in_range = collect_parts(
+        system,
+        density,
+        magnitude,
+        Some(overlaps),
+        &mut parts,
+        counted,
+    );
+    by_rank(
+        &parts,
+        (buckets, &histograms),
+        in_range,
+        usize::MAX,
+        &mut samples,
+    );
     samples
 }
 
 /// The accepted samples of each root's subtree, in root order, into
 /// `parts` (one list per root, their memory reused); with `histograms`,
 /// also each root's count of samples per rank bucket, taken while its
-/// samples are still in cache.
+/// samples are still in cache. False when some rank lies outside `[0, 1)`
+/// (never for the engine's ranks; not checked without `histograms`).
 fn collect_parts<S, D>(
     system: &S,
     density: &D,
@@ -130,7 +146,8 @@ fn collect_parts<S, D>(
     window: Option<&Window<'_, S::Region>>,
     parts: &mut Vec<Vec<Sample<S::Point>>>,
     histograms: Option<(RankBuckets, &mut Vec<Vec<u32>>)>,
-) where
+) -> bool
+where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
@@ -171,30 +188,31 @@ fn collect_parts<S, D>(
         .par_iter()
         .zip(parts.par_iter_mut())
         .zip(counts.par_iter_mut())
-        .for_each(|((root, out), counts)| {
+        .map(|((root, out), counts)| {
             out.clear();
             out.reserve(share(root));
             walker.visit(root, f64::INFINITY, out);
-            match buckets {
-                Some(buckets) => buckets.count_into(out, counts),
-                None => counts.clear(),
-            }
-        });
+            counts.clear();
+            buckets.is_none_or(|buckets| buckets.count_into(out, counts))
+        })
+        .reduce(|| true, |a, b| a && b)
 }
 
-/// The rank buckets of [`Order::Unsorted`]'s histograms: monotone in the
-/// rank, ranks outside [0, 1) going to the end buckets.
+/// The rank buckets of the per-root histograms the ranking starts from:
+/// bucket `b` holds the ranks in `[b, b + 1) / count`, ranks below 0 going
+/// to the first and from 1 on to the last (monotone in the rank).
 #[derive(Clone, Copy)]
 struct RankBuckets {
     count: usize,
 }
 
 impl RankBuckets {
-    /// About 32 samples a bucket for `magnitude` samples, at most 1024
-    /// (a root's histogram stays within 4 KB).
+    /// About 2048 samples a bucket for `magnitude` samples (a group that
+    /// [`sort_group`] sorts in cache), 16 to 4096 buckets (a root's
+    /// histogram stays within 16 KB).
     fn for_magnitude(magnitude: f64) -> Self {
         RankBuckets {
-            count: ((magnitude / 32.0) as usize).clamp(16, 1024),
+            count: ((magnitude / 2048.0) as usize).clamp(16, 4096),
         }
     }
 
@@ -203,13 +221,32 @@ impl RankBuckets {
         ((rank * self.count as f64) as usize).min(self.count - 1)
     }
 
-    /// The samples per bucket, into `counts` (replacing its contents).
-    fn count_into<P>(&self, samples: &[Sample<P>], counts: &mut Vec<u32>) {
+    /// The samples per bucket, into `counts` (left empty for no samples, so
+    /// that the empty roots of a window cost nothing); false when a rank
+    /// lies outside `[0, 1)`.
+    fn count_into<P>(&self, samples: &[Sample<P>], counts: &mut Vec<u32>) -> bool {
         counts.clear();
+        if samples.is_empty() {
+            return true;
+        }
         counts.resize(self.count, 0);
+        let mut in_range = true;
         for s in samples {
+            in_range &= (0.0..1.0).contains(&s.rank);
             counts[self.of(s.rank)] += 1;
         }
+        in_range
+    }
+
+    /// The histograms' sum: samples per bucket over every root.
+    fn total(&self, histograms: &[Vec<u32>]) -> Vec<usize> {
+        let mut counts = vec![0usize; self.count];
+        for histogram in histograms {
+            for (total, &c) in counts.iter_mut().zip(histogram) {
+                *total += c as usize;
+            }
+        }
+        counts
     }
 }
 
@@ -633,14 +670,16 @@ where
     } else {
         count as f64
     };
-    // an unsorted request counts ranks as each root finishes
+    // ranks are counted as each root finishes, for the ranking
     let mut collect = |magnitude: f64, parts: &mut Vec<_>| {
         let buckets = RankBuckets::for_magnitude(magnitude);
-        let counted = (order == Order::Unsorted).then_some((buckets, &mut *histograms));
-        collect_parts(system, density, magnitude, None, parts, counted);
-        buckets
+        let counted = Some((buckets, &mut *histograms));
+        (
+            buckets,
+            collect_parts(system, density, magnitude, None, parts, counted),
+        )
     };
-    let mut buckets = collect(magnitude, parts);
+    let (mut buckets, mut in_range) = collect(magnitude, parts);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
     for _ in 0..40 {
         let found = total(parts);
@@ -653,7 +692,7 @@ where
             (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
         };
         magnitude *= growth;
-        buckets = collect(magnitude, parts);
+        (buckets, in_range) = collect(magnitude, parts);
     }
     if exact && total(parts) < count {
         let found = total(parts);
@@ -664,7 +703,7 @@ where
     }
     let keep = if exact { count } else { usize::MAX };
     match order {
-        Order::Progressive => by_rank(parts, keep, out),
+        Order::Progressive => by_rank(parts, (buckets, histograms), in_range, keep, out),
         Order::Unsorted => smallest_ranks(parts, (buckets, histograms), keep, out),
     }
     Ok(out)
@@ -693,12 +732,7 @@ fn smallest_ranks<P: Copy>(
         }
         return;
     }
-    let mut counts = vec![0usize; buckets.count];
-    for histogram in histograms {
-        for (total, &c) in counts.iter_mut().zip(histogram) {
-            *total += c as usize;
-        }
-    }
+    let counts = buckets.total(histograms);
     // `cut` holds the `keep`-th smallest rank; `below` samples lie in the
     // buckets before it, kept whole
     let (mut cut, mut below) = (0, 0);
@@ -723,12 +757,18 @@ fn smallest_ranks<P: Copy>(
 
 /// The `keep` samples of smallest rank (all when fewer), ordered by rank,
 /// into `out` (replacing its contents); ties keep their deterministic root
-/// order (as a stable sort would).
-fn by_rank<P: Copy + Send + Sync>(parts: &[Vec<Sample<P>>], keep: usize, out: &mut Vec<Sample<P>>) {
+/// order (as a stable sort would). `histograms` count each root's ranks;
+/// `in_range` says every rank lies in `[0, 1)`.
+fn by_rank<P: Copy + Send + Sync>(
+    parts: &[Vec<Sample<P>>],
+    histograms: (RankBuckets, &[Vec<u32>]),
+    in_range: bool,
+    keep: usize,
+    out: &mut Vec<Sample<P>>,
+) {
     let n: usize = parts.iter().map(Vec::len).sum();
-    let samples = || parts.iter().flatten();
-    if n < u32::MAX as usize && samples().all(|s| (0.0..1.0).contains(&s.rank)) {
-        bucket_by_rank(parts, n, keep, out);
+    if in_range && n < u32::MAX as usize {
+        sort_by_groups(parts, histograms, n, keep, out);
         return;
     }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in
@@ -747,14 +787,13 @@ fn by_rank<P: Copy + Send + Sync>(parts: &[Vec<Sample<P>>], keep: usize, out: &m
 
 /// [`by_rank`] for the `n` samples of `parts` when their ranks lie in
 /// `[0, 1)` (the engine's ranks: `code / d` with `code + 1/2 < d`): a
-/// counting sort on the rank's value scaled to about one sample a bucket
-/// (monotone in the rank, so only samples within a bucket need ordering),
-/// in two passes so that writes stay in cache: samples are first
-/// distributed into groups of [`GROUP_BUCKETS`] buckets, streamed into
-/// `out`, then each group (a few hundred KB) is sorted within itself.
-/// Samples in groups past the `keep`-th sample are skipped.
-fn bucket_by_rank<P: Copy + Send + Sync>(
+/// counting sort in two passes that keep writes in cache. The histograms'
+/// buckets are groups of about 2048 samples: one pass streams each sample
+/// into its group's place in `out`, then each group is sorted within
+/// itself. Groups past the `keep`-th sample are skipped.
+fn sort_by_groups<P: Copy + Send + Sync>(
     parts: &[Vec<Sample<P>>],
+    (buckets, histograms): (RankBuckets, &[Vec<u32>]),
     n: usize,
     keep: usize,
     out: &mut Vec<Sample<P>>,
@@ -763,15 +802,9 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
         out.clear();
         return;
     };
-    let buckets = n.max(1);
-    // (`n` < 2^32, so the bucket fits u32, whose conversion is the cheaper)
-    let (scale, last) = (buckets as f64, buckets as u32 - 1);
-    let bucket = |s: &Sample<P>| ((s.rank * scale) as u32).min(last) as usize;
-    let groups = buckets.div_ceil(GROUP_BUCKETS);
+    let groups = buckets.count;
     let mut start = vec![0usize; groups + 1];
-    for s in parts.iter().flatten() {
-        start[bucket(s) / GROUP_BUCKETS + 1] += 1;
-    }
+    start[1..].copy_from_slice(&buckets.total(histograms));
     for g in 0..groups {
         start[g + 1] += start[g];
     }
@@ -783,7 +816,7 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
     out.resize(start[used], first);
     // `start[g]` moves to the end of group g while filling
     for s in parts.iter().flatten() {
-        let g = bucket(s) / GROUP_BUCKETS;
+        let g = buckets.of(s.rank);
         if g < used {
             out[start[g]] = *s;
             start[g] += 1;
@@ -794,46 +827,50 @@ fn bucket_by_rank<P: Copy + Send + Sync>(
     let mut lo = 0;
     for (g, &end) in ends.iter().enumerate() {
         let (slice, tail) = rest.split_at_mut(end - lo);
-        slices.push((g * GROUP_BUCKETS, slice));
+        slices.push((g, slice));
         rest = tail;
         lo = end;
     }
+    let scale = groups as f64;
     slices
         .into_par_iter()
-        .for_each_init(Default::default, |scratch, (first_bucket, group)| {
-            sort_group(group, first_bucket, bucket, scratch);
+        .for_each_init(Default::default, |scratch, (g, group)| {
+            // where in the group's rank interval: monotone, in [0, 1]
+            sort_group(group, |rank| rank * scale - g as f64, scratch);
         });
     out.truncate(keep);
 }
 
-/// Buckets per group of [`bucket_by_rank`]'s first pass: a group of about
-/// that many samples (a few hundred KB) is sorted in cache.
-const GROUP_BUCKETS: usize = 8192;
-
-/// Sorts `group`, whose samples fall in buckets `first_bucket..` (fewer
-/// than [`GROUP_BUCKETS`] of them), by rank: a stable counting sort by
-/// bucket through `scratch` (each sample's bucket computed once, into
-/// `local`), then a stable sort of each bucket holding several.
+/// Sorts `group` by rank: a stable counting sort through `scratch` on
+/// `within(rank)` (monotone in the rank, in `[0, 1]`) scaled to about one
+/// sample a bucket (each sample's bucket computed once, into `local`),
+/// then a stable sort of each bucket holding several.
 fn sort_group<P: Copy>(
     group: &mut [Sample<P>],
-    first_bucket: usize,
-    bucket: impl Fn(&Sample<P>) -> usize,
-    (scratch, local): &mut (Vec<Sample<P>>, Vec<u16>),
+    within: impl Fn(f64) -> f64,
+    (scratch, local, start): &mut (Vec<Sample<P>>, Vec<u32>, Vec<u32>),
 ) {
-    let Some(&first) = group.first() else {
+    let len = group.len();
+    if len < 2 {
         return;
-    };
+    }
+    let (scale, last) = (len as f64, len as u32 - 1);
     local.clear();
-    local.extend(group.iter().map(|s| (bucket(s) - first_bucket) as u16));
-    let mut start = [0u32; GROUP_BUCKETS + 1];
+    local.extend(
+        group
+            .iter()
+            .map(|s| ((within(s.rank) * scale) as u32).min(last)),
+    );
+    start.clear();
+    start.resize(len + 1, 0);
     for &b in local.iter() {
         start[b as usize + 1] += 1;
     }
-    for b in 0..GROUP_BUCKETS {
+    for b in 0..len {
         start[b + 1] += start[b];
     }
     scratch.clear();
-    scratch.resize(group.len(), first);
+    scratch.resize(len, group[0]);
     for (s, &b) in group.iter().zip(local.iter()) {
         let at = &mut start[b as usize];
         scratch[*at as usize] = *s;
@@ -842,7 +879,7 @@ fn sort_group<P: Copy>(
     // `start[b]` is now the end of bucket b; most hold one sample, a
     // quarter two or more
     let mut lo = 0;
-    for &hi in &start[..GROUP_BUCKETS] {
+    for &hi in &start[..len] {
         let hi = hi as usize;
         match hi - lo {
             0 | 1 => {}
@@ -1025,21 +1062,18 @@ mod tests {
             let mut expected = parts.concat();
             expected.sort_by(|a, b| a.rank.total_cmp(&b.rank));
             expected.truncate(keep);
+            let buckets = RankBuckets::for_magnitude(n as f64);
+            let mut histograms = vec![Vec::new(); parts.len()];
+            let in_range = parts
+                .iter()
+                .zip(&mut histograms)
+                .fold(true, |all, (part, counts)| buckets.count_into(part, counts) && all);
             let mut out = vec![Sample { position: 0, rank: 0.5 }; 3];
-            by_rank(&parts, keep, &mut out);
+            by_rank(&parts, (buckets, &histograms), in_range, keep, &mut out);
             prop_assert_eq!(&out, &expected);
             // unsorted: the same samples, in root order but for those of
             // the last kept one's bucket, which follow in rank order
             let mut unsorted = vec![Sample { position: 0, rank: 0.5 }; 3];
-            let buckets = RankBuckets::for_magnitude(n as f64);
-            let histograms: Vec<Vec<u32>> = parts
-                .iter()
-                .map(|part| {
-                    let mut counts = Vec::new();
-                    buckets.count_into(part, &mut counts);
-                    counts
-                })
-                .collect();
             smallest_ranks(&parts, (buckets, &histograms), keep, &mut unsorted);
             let bucket = |s: &Sample<u32>| buckets.of(s.rank);
             // (a request keeping every sample copies them all in root order)
