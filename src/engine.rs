@@ -27,9 +27,10 @@
 //! 1e-300..1e300, subnormals included, from overflowing). Ranks order the output progressively: the samples with rank
 //! below `s` are those an `s`-times smaller request accepts, so every prefix
 //! of the output is itself a well-spread set. The roots are visited in parallel and
-//! gathered in order, so the output does not depend on the thread count;
-//! a counting sort on the rank then orders them (ties in root order), or,
-//! for [`Order::Unsorted`], a histogram of the ranks only finds which to keep.
+//! gathered in order, so the output does not depend on the thread count.
+//! Each root counts its ranks as it finishes; from those histograms a
+//! counting sort orders the samples by rank (ties in root order), or, for
+//! [`Order::Unsorted`], finds only which to keep.
 
 use crate::density::{Density, Region};
 use crate::tiling::{code_value, Code, TileSystem};
