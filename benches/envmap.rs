@@ -17,7 +17,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use tessera::baselines::envmap::{AliasTable, InverseCdf};
 use tessera::density::envmap::{EnvMap, Up};
-use tessera::engine::{self, Buffers, Order};
+use tessera::engine::{self, Order};
 use tessera::io::image::{read_raster, ReadOptions};
 use tessera::tiling::sphere::SphereTiling;
 
@@ -69,10 +69,8 @@ fn per_sample(c: &mut Criterion) {
     group.bench_function("tessera_1_thread_unsorted", |b| {
         b.iter(|| {
             one.install(|| {
-                let mut buffers = Buffers::default();
-                engine::generate_into(&sphere, &map, N, true, Order::Unsorted, &mut buffers)
-                    .expect("samples");
-                black_box(buffers.into_samples())
+                let samples = engine::generate_ordered(&sphere, &map, N, true, Order::Unsorted);
+                black_box(samples.expect("samples"))
             })
         })
     });

@@ -494,15 +494,32 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
+    generate_ordered(system, density, count, exact, Order::Progressive)
+}
+
+/// [`generate`] with the output in the given `order`, into fresh memory.
+///
+/// # Example
+/// ```
+/// use tessera::{density::plane::Ramp, engine::{self, Order}, tiling::plane::PlaneTiling};
+/// let tiling = PlaneTiling::ppentomino();
+/// let s = engine::generate_ordered(&tiling, &Ramp, 500, true, Order::Unsorted).unwrap();
+/// assert_eq!(s.len(), 500);
+/// ```
+pub fn generate_ordered<S, D>(
+    system: &S,
+    density: &D,
+    count: usize,
+    exact: bool,
+    order: Order,
+) -> Result<Vec<Sample<S::Point>>, Error>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
     let mut buffers = Buffers::default();
-    generate_into(
-        system,
-        density,
-        count,
-        exact,
-        Order::Progressive,
-        &mut buffers,
-    )?;
+    generate_into(system, density, count, exact, order, &mut buffers)?;
     Ok(buffers.into_samples())
 }
 

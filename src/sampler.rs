@@ -128,9 +128,8 @@ where
     /// assert!(s.windows(2).all(|w| w[0].rank <= w[1].rank));
     /// ```
     pub fn generate(&self) -> Result<Vec<Sample<S::Point>>, Error> {
-        let mut buffers = engine::Buffers::default();
-        self.generate_into(&mut buffers)?;
-        Ok(buffers.into_samples())
+        let (count, exact, order) = (self.count, self.exact, self.order);
+        engine::generate_ordered(&self.system, &self.density, count, exact, order)
     }
 
     /// [`Sampler::generate`] into memory kept between requests (see
@@ -214,10 +213,8 @@ where
         rect: &crate::density::rectangle::Rectangle,
     ) -> Result<Vec<Sample<glam::DVec2>>, Error> {
         let density = rect.restrict(&self.density);
-        let mut buffers = engine::Buffers::default();
         let (count, exact, order) = (self.count, self.exact, self.order);
-        engine::generate_into(&self.system, &density, count, exact, order, &mut buffers)?;
-        let mut samples = buffers.into_samples();
+        let mut samples = engine::generate_ordered(&self.system, &density, count, exact, order)?;
         for s in &mut samples {
             s.position = rect.to_world(s.position);
         }

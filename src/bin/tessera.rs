@@ -158,16 +158,7 @@ impl RequestArgs {
         } else {
             Order::Progressive
         };
-        let mut buffers = engine::Buffers::default();
-        engine::generate_into(
-            system,
-            density,
-            self.count,
-            !self.expected,
-            order,
-            &mut buffers,
-        )?;
-        Ok(buffers.into_samples())
+        engine::generate_ordered(system, density, self.count, !self.expected, order)
     }
 }
 
