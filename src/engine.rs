@@ -7,19 +7,22 @@
 //!     else b = magnitude * bound(tile) / mean;  terminal if capacity(level) >= b
 //!     if terminal:
 //!         d = magnitude * average(tile) / mean
-//!         constant density: if code(tile) + 1/2 < d: emit(sample(tile, d / capacity), rank code / d)
-//!         else, from g = d (up to 3 tries):
-//!             p = sample(tile, g / capacity(level)); h = density(p), capped at b
-//!             h = 0 (off the support): retry once with g = b, else drop
-//!             h within 1.1x of g: if code(tile) + 1/2 < h: emit(p, rank = code / h); stop
-//!             else retry with g = h
+//!         constant density: keep if code(tile) + 1/2 < d, at sample(tile, d / capacity(level))
+//!         else p = sample(tile, d / capacity(level)), h = density(p) (capped at b):
+//!             h within 1.5x of d (smooth): keep by d (rank code / d), re-placed
+//!                 for h when h is over 1.1x from d and that placement lands within 1.1x of h
+//!             else (a contrast in the tile): from g = b, up to 3 times:
+//!                 p = sample(tile, g / capacity(level)), h = density(p):
+//!                 h = 0: drop; h within 1.1x of g: keep by h; else g = h
 //!     else: visit every child
 //! ```
-//! A varying density keeps a tile's sample by its value where the sample
-//! lands, and the sample is placed for that value: a tile straddling a
-//! contrast edge acts as a bright tile when its sample lands on the bright
-//! side and as a dim one on the dim side, so no edge leaks samples across
-//! or places them with another density's offsets.
+//! A sample is placed for the density it lands on (within about one
+//! importance bin), and a tile straddling a contrast is kept by that
+//! density: it acts as a bright tile when its sample lands on the bright
+//! side and as a dim one on the dim side, so edges neither leak samples
+//! across nor put samples placed for one density among another's. Smooth
+//! tiles keep the average, an exact integral over the tile, which
+//! integrates better than the one-point value.
 //! Children are skipped on their code alone when `b` makes them terminal
 //! and rejects them; systems that know their children's code order
 //! ([`TileSystem::child_by_code_rank`]) are visited in it, stopping at the
@@ -261,24 +264,33 @@ impl RankBuckets {
 /// (24 MB of planar samples).
 const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
 
-/// Placements a terminal tile tries before it drops its sample: each
-/// after the first uses the density the previous one landed on.
+/// Placements a tile straddling a contrast tries before it drops its
+/// sample: each after the first is for the density the previous one
+/// landed on.
 const PLACEMENT_TRIES: usize = 3;
 
 /// Largest ratio between the density a sample was placed for and the
-/// density where it landed for the placement to stand: about one
-/// importance bin of the shipped tables (adjacent bins are 1.05 to 1.13
-/// apart, the sphere's 4^(1/11) the widest). Over 300 random lat-long maps (`tests/properties.rs`'s kind) a
-/// tolerance of 2 left close pairs where a tile placed for its average
-/// landed on a pixel 1.3 to 1.9 times brighter; 1.1 and 1.03 gave the same
-/// separations, 1.25 worse.
+/// density it lands on for the placement to stand: about one importance
+/// bin of the shipped tables (adjacent bins are 1.05 to 1.13 apart). A
+/// sample placed for one density among samples placed for another is
+/// what clumped at contrast edges; 2 still left such pairs, 1.03 gave no
+/// better separation than 1.1.
 const PLACEMENT_TOLERANCE: f64 = 1.1;
 
-/// Whether a sample placed for density `guess` landed on a density
-/// `found` close enough for the placement to stand.
+/// Largest ratio between a tile's average density and the density its
+/// sample lands on for the tile to count as smooth and keep its sample by
+/// the average (the exact integral over the tile). Beyond it the tile
+/// straddles a contrast and the density where its sample lands keeps it.
+/// Keeping by that one-point value everywhere spread samples best at
+/// edges but raised the irradiance error on the smooth sky by a fifth
+/// (`cargo run --release --example envmap`); 1.25 to 2 kept the error of
+/// the average rule, 1.5 with the least support-edge bias.
+const SMOOTH_RATIO: f64 = 1.5;
+
+/// Whether `a` and `b` are within a factor `ratio` of each other.
 #[inline(always)]
-fn consistent(guess: f64, found: f64) -> bool {
-    found * PLACEMENT_TOLERANCE >= guess && found <= PLACEMENT_TOLERANCE * guess
+fn within(ratio: f64, a: f64, b: f64) -> bool {
+    a * ratio >= b && b * ratio >= a
 }
 
 struct Walker<'a, S: TileSystem, D: ?Sized> {
@@ -409,15 +421,16 @@ where
     }
 
     /// Places the sample of a terminal tile of code `code`, average density
-    /// `d` and scaled bound `bound` (code units), if the density where it
-    /// lands keeps it (see the module doc).
+    /// `d` and scaled bound `bound` (code units), if its code is kept (see
+    /// the module doc).
     ///
-    /// Keeping by the tile's average instead (the earlier rule) leaked
-    /// samples at the bright rate across every contrast edge, and placing
-    /// for the average put them with offsets meant for another density:
-    /// over 300 random lat-long maps the median normalised separation was
-    /// 0.14 (0.55 now), and a sun 5,000 times the sky had pairs at 0.005
-    /// of the local spacing (0.33 now).
+    /// The earlier rule kept every sample by the tile's average and placed
+    /// it for the average: at contrast edges, straddling tiles leaked
+    /// samples at the bright rate into the dim side, and samples placed
+    /// for one density sat among samples placed for another. The
+    /// contrast tests of `tests/properties.rs` print the separations on
+    /// random maps and beside a sun, which that rule made 3 to 60 times
+    /// smaller.
     #[inline(always)]
     fn emit(
         &self,
@@ -452,23 +465,49 @@ where
         if d.is_nan() || d <= 0.0 {
             return; // a tile whose average is 0 carries nothing
         }
-        let mut guess = d;
-        for _ in 0..PLACEMENT_TRIES {
-            let Some(position) = place(guess) else {
-                return; // the tiling reaches past the domain there
-            };
+        if bound <= PLACEMENT_TOLERANCE * d && !keeps(d) {
+            // a tile whose bound is this close to its average is smooth,
+            // kept by the average: rejected without a placement (most
+            // tiles of a smooth density)
+            return;
+        }
+        let landing = |density: f64| {
+            let position = place(density)?;
             let here = self.scaled(self.density.value(position)).min(bound);
-            if here.is_nan() || here <= 0.0 {
-                // off the support: the densest placement the tile's bound
-                // allows is the last to try (a tile on the support's edge
-                // whose average placed its sample outside)
-                if guess >= bound {
-                    return;
-                }
-                guess = bound;
-                continue;
+            Some((position, if here.is_nan() { 0.0 } else { here }))
+        };
+        // the tiling may reach past the domain: no sample there
+        let Some((position, here)) = landing(d) else {
+            return;
+        };
+        if here > 0.0 && within(SMOOTH_RATIO, here, d) {
+            // a smooth tile: its average, an exact integral over the tile,
+            // keeps the sample; it is placed for the density it lands on
+            if !keeps(d) {
+                return;
             }
-            if consistent(guess, here) {
+            let position = match within(PLACEMENT_TOLERANCE, d, here) {
+                true => position,
+                false => landing(here)
+                    .filter(|&(_, there)| within(PLACEMENT_TOLERANCE, here, there))
+                    .map_or(position, |(p, _)| p),
+            };
+            return out.push(Sample {
+                position,
+                rank: code / d,
+            });
+        }
+        // a contrast inside the tile: from its bound down, the placement
+        // that lands on the density it was placed for, kept by that density
+        let mut guess = bound;
+        for _ in 0..PLACEMENT_TRIES {
+            let Some((position, here)) = landing(guess) else {
+                return;
+            };
+            if here <= 0.0 {
+                return; // off the support
+            }
+            if within(PLACEMENT_TOLERANCE, guess, here) {
                 if keeps(here) {
                     out.push(Sample {
                         position,

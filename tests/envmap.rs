@@ -235,9 +235,9 @@ fn seeds_give_unbiased_independent_estimates() {
         })
         .collect();
     let mean = estimates.iter().sum::<f64>() / estimates.len() as f64;
-    // samples in tiles straddling the support's edge lean inwards: a bias
-    // that shrinks as 1/sqrt(N)
-    assert!((mean - exact).abs() < 0.01 * exact, "{mean} vs {exact}");
+    // tiles straddling the support's edge that the average keeps place
+    // their samples inside it: a small inward lean (0.2 % over 64 seeds)
+    assert!((mean - exact).abs() < 0.006 * exact, "{mean} vs {exact}");
     assert!(estimates.windows(2).all(|w| w[0] != w[1]));
     // deterministic without a seed
     assert_eq!(map.generate(n).unwrap(), map.generate(n).unwrap());
