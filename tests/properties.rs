@@ -384,6 +384,13 @@ fn fixed_maps(count: usize, sizes: std::ops::Range<usize>) -> Vec<(usize, usize,
     maps
 }
 
+/// The normalised separation of `n` samples of `map`.
+fn separation_of_request(map: &EnvMap, n: usize) -> f64 {
+    let samples = map.generate(n).unwrap();
+    let points: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
+    normalised_separation(map, &points)
+}
+
 /// The smallest, 5th-percentile and median of `values`.
 fn spread_summary(mut values: Vec<f64>) -> [f64; 3] {
     values.sort_by(f64::total_cmp);
@@ -403,13 +410,7 @@ fn contrast_edges_keep_sphere_samples_spread() {
         .into_iter()
         .map(|(w, h, values, n)| {
             let map = map_of(w, h, values);
-            let points: Vec<DVec3> = map
-                .generate(n)
-                .unwrap()
-                .iter()
-                .map(|s| s.position)
-                .collect();
-            normalised_separation(&map, &points)
+            separation_of_request(&map, n)
         })
         .collect();
     let [min, p5, median] = spread_summary(separations);
@@ -467,13 +468,7 @@ fn a_sun_beside_the_sky_keeps_samples_spread() {
         .collect();
     let map = map_of(w, h, values);
     for n in [1000, 4096, 16384] {
-        let points: Vec<DVec3> = map
-            .generate(n)
-            .unwrap()
-            .iter()
-            .map(|s| s.position)
-            .collect();
-        let separation = normalised_separation(&map, &points);
+        let separation = separation_of_request(&map, n);
         println!("sun beside the sky, N = {n}: separation {separation:.3}");
         assert!(separation >= 0.25, "N = {n}: {separation}");
     }
