@@ -281,10 +281,11 @@ const PLACEMENT_TOLERANCE: f64 = 1.1;
 /// sample lands on for the tile to count as smooth and keep its sample by
 /// the average (the exact integral over the tile). Beyond it the tile
 /// straddles a contrast and the density where its sample lands keeps it.
-/// Keeping by that one-point value everywhere spread samples best at
-/// edges but raised the irradiance error on the smooth sky by a fifth
-/// (`cargo run --release --example envmap`); 1.25 to 2 kept the error of
-/// the average rule, 1.5 with the least support-edge bias.
+/// Keeping by that one-point value everywhere (commit `d8dde94`) spread
+/// samples best at edges but raised the irradiance errors of `cargo run
+/// --release --example envmap` from 4.08e-3 and 5.41e-3 to 5.41e-3 and
+/// 6.05e-3. In scratch runs ratios of 1.25 to 2 kept the average rule's
+/// errors on a smooth sky, 1.5 with the least support-edge bias.
 const SMOOTH_RATIO: f64 = 1.5;
 
 /// Whether `a` and `b` are within a factor `ratio` of each other.
