@@ -487,11 +487,12 @@ where
             if !keeps(d) {
                 return;
             }
-            let position = match within(PLACEMENT_TOLERANCE, d, here) {
-                true => position,
-                false => landing(here)
+            let position = if within(PLACEMENT_TOLERANCE, d, here) {
+                position
+            } else {
+                landing(here)
                     .filter(|&(_, there)| within(PLACEMENT_TOLERANCE, here, there))
-                    .map_or(position, |(p, _)| p),
+                    .map_or(position, |(p, _)| p)
             };
             return out.push(Sample {
                 position,

@@ -89,9 +89,6 @@ impl<T: TileSystem, F: Fn(&T, &T::Tile, T::Point, f64) -> bool + Sync> TileSyste
     fn codes_per_sample(&self) -> f64 {
         self.inner.codes_per_sample()
     }
-    fn tile_with_code(&self, level: u32, code: Code) -> Option<T::Tile> {
-        self.inner.tile_with_code(level, code)
-    }
     fn sample_in_domain(&self, tile: &T::Tile, fraction: f64) -> Option<T::Point> {
         let p = self.inner.sample_in_domain(tile, fraction)?;
         Some(self.check(tile, p, fraction))
