@@ -951,9 +951,10 @@ fn sort_by_groups<P: Copy + Send + Sync>(
 }
 
 /// Sorts `group` by rank: a stable counting sort through `scratch` on
-/// `within(rank)` (monotone in the rank, in `[0, 1]`) scaled to about one
-/// sample a bucket (each sample's bucket computed once, into `local`),
-/// then a stable sort of each bucket holding several.
+/// `within(rank)` (monotone in the rank, in `[0, 1]`) into about
+/// [`SORT_SPREAD`] buckets a sample (each sample's bucket computed once,
+/// into `local`), then an insertion pass back into `group` that moves the
+/// few samples sharing a bucket out of order.
 fn sort_group<P: Copy>(
     group: &mut [Sample<P>],
     within: impl Fn(f64) -> f64,
@@ -963,7 +964,8 @@ fn sort_group<P: Copy>(
     if len < 2 {
         return;
     }
-    let (scale, last) = (len as f64, len as u32 - 1);
+    let buckets = len * SORT_SPREAD;
+    let (scale, last) = (buckets as f64, buckets as u32 - 1);
     local.clear();
     local.extend(
         group
@@ -971,11 +973,11 @@ fn sort_group<P: Copy>(
             .map(|s| ((within(s.rank) * scale) as u32).min(last)),
     );
     start.clear();
-    start.resize(len + 1, 0);
+    start.resize(buckets + 1, 0);
     for &b in local.iter() {
         start[b as usize + 1] += 1;
     }
-    for b in 0..len {
+    for b in 0..buckets {
         start[b + 1] += start[b];
     }
     scratch.clear();
@@ -985,24 +987,38 @@ fn sort_group<P: Copy>(
         scratch[*at as usize] = *s;
         *at += 1;
     }
-    // `start[b]` is now the end of bucket b; most hold one sample, a
-    // quarter two or more
-    let mut lo = 0;
-    for &hi in &start[..len] {
-        let hi = hi as usize;
-        match hi - lo {
-            0 | 1 => {}
-            2 => {
-                if scratch[lo + 1].rank.total_cmp(&scratch[lo].rank).is_lt() {
-                    scratch.swap(lo, lo + 1);
-                }
-            }
-            _ => scratch[lo..hi].sort_by(|a, b| a.rank.total_cmp(&b.rank)),
+    // nearly sorted: a sample moves back past the few of its own bucket
+    // with a larger rank (strictly larger: ties keep their order); `last`,
+    // the largest rank placed so far, keeps the common case from reading
+    // back what it just wrote
+    let (mut last, mut moves) = (f64::NEG_INFINITY, 0);
+    for (i, &s) in scratch.iter().enumerate() {
+        if s.rank >= last {
+            group[i] = s;
+            last = s.rank;
+            continue;
         }
-        lo = hi;
+        let mut j = i;
+        while j > 0 && s.rank < group[j - 1].rank {
+            group[j] = group[j - 1];
+            j -= 1;
+        }
+        group[j] = s;
+        moves += i - j;
+        if moves > SORT_SPREAD * len {
+            // ranks packed closer than the buckets: a quadratic insertion
+            // pass would follow, so a stable sort of the bucket order
+            // (which kept ties in order) takes over
+            group.copy_from_slice(scratch);
+            group.sort_by(|a, b| a.rank.total_cmp(&b.rank));
+            return;
+        }
     }
-    group.copy_from_slice(scratch);
 }
+
+/// Buckets a sample in [`sort_group`]'s counting sort: enough that few
+/// samples share one and its insertion pass rarely moves a sample.
+const SORT_SPREAD: usize = 2;
 
 /// An unsigned key ordered like [`f64::total_cmp`].
 fn total_order_key(x: f64) -> u64 {
@@ -1145,7 +1161,13 @@ mod tests {
         #[test]
         fn ranking_is_a_stable_sort_by_rank(
             sizes in prop::collection::vec(0usize..4000, 1..6),
-            distinct in prop_oneof![Just(7u64), Just(1u64 << 40)],
+            // few ranks (ties), distinct ranks, and ranks packed closer
+            // than the sort's buckets
+            (distinct, packed) in prop_oneof![
+                Just((7u64, false)),
+                Just((1u64 << 40, false)),
+                Just((1024u64, true)),
+            ],
             seed in any::<u64>(),
             keep_share in 0.0f64..1.2,
         ) {
@@ -1160,7 +1182,12 @@ mod tests {
                     let part = (0..size)
                         .map(|_| {
                             *id += 1;
-                            Sample { position: *id, rank: next() as f64 / distinct as f64 }
+                            let rank = if packed {
+                                0.25 + next() as f64 * 2f64.powi(-50)
+                            } else {
+                                next() as f64 / distinct as f64
+                            };
+                            Sample { position: *id, rank }
                         })
                         .collect();
                     Some(part)

@@ -197,6 +197,7 @@ impl<D: Density<PlaneRegion>> Density<PlaneRegion> for OnRectangle<D> {
         if inside.count == 0 {
             return 0.0;
         }
+        inside.centroid = inside.centres().iter().sum::<DVec2>() / inside.count as f64;
         self.density.average(&inside) * inside.count as f64 / region.count as f64
     }
 

@@ -584,6 +584,7 @@ impl TileSystem for PenroseTiling {
             cell: edge,
             cells: [DVec2::ZERO; MAX_CELLS],
             count: 1,
+            centroid: tile.v[0],
         };
         if tile.kind.is_point() {
             // about the point's own share of the plane (0.81 edge^2)
@@ -594,6 +595,7 @@ impl TileSystem for PenroseTiling {
         // is the centroid, so linear densities average exactly
         let [a, b, c] = tile.v;
         region.cells[0] = (a + b + c) / 3.0;
+        region.centroid = region.cells[0];
         region.cells[1] = (4.0 * a + b + c) / 6.0;
         region.cells[2] = (a + 4.0 * b + c) / 6.0;
         region.cells[3] = (a + b + 4.0 * c) / 6.0;

@@ -69,6 +69,9 @@ pub struct PlaneRegion {
     pub cells: [DVec2; MAX_CELLS],
     /// Number of cells.
     pub count: u8,
+    /// Mean of the cell centres, kept with them by whoever fills them: a
+    /// linear density's average over the tile is its value here.
+    pub centroid: DVec2,
 }
 
 impl PlaneRegion {
@@ -134,7 +137,7 @@ pub struct PlaneTiling {
     bin_edges: Vec<f64>,
 }
 
-/// A rep-tile's cell centres and the corners of its bounding box, relative
+/// A rep-tile's cell centres, their mean and the corners of its bounding box, relative
 /// to a placement's origin, in one orientation (in cells, as f64 so that a
 /// region costs a multiply-add per coordinate). `centres` is padded to
 /// [`MAX_CELLS`] by repeating the first, so a region is filled without
@@ -143,6 +146,7 @@ pub struct PlaneTiling {
 struct Frame {
     centres: [DVec2; MAX_CELLS],
     count: u8,
+    centroid: DVec2,
     lo: DVec2,
     hi: DVec2,
 }
@@ -166,6 +170,7 @@ impl Frame {
         Frame {
             centres: std::array::from_fn(|i| corners.get(i).unwrap_or(&corners[0]) + 0.5),
             count: corners.len() as u8,
+            centroid: corners.iter().copied().sum::<DVec2>() / corners.len() as f64 + 0.5,
             lo,
             hi: hi + 1.0,
         }
@@ -507,6 +512,7 @@ impl TileSystem for PlaneTiling {
             cell: s,
             cells,
             count: frame.count,
+            centroid: (origin + frame.centroid) * s,
         }
     }
 
