@@ -951,13 +951,13 @@ fn sort_by_groups<P: Copy + Send + Sync>(
 }
 
 /// Sorts `group` by rank: a stable counting sort through `scratch` on
-/// `within(rank)` (monotone in the rank, in `[0, 1]`) into about
+/// `in_group(rank)` (monotone in the rank, in `[0, 1]`) into about
 /// [`SORT_SPREAD`] buckets a sample (each sample's bucket computed once,
 /// into `local`), then an insertion pass back into `group` that moves the
 /// few samples sharing a bucket out of order.
 fn sort_group<P: Copy>(
     group: &mut [Sample<P>],
-    within: impl Fn(f64) -> f64,
+    in_group: impl Fn(f64) -> f64,
     (scratch, local, start): &mut (Vec<Sample<P>>, Vec<u32>, Vec<u32>),
 ) {
     let len = group.len();
@@ -965,12 +965,12 @@ fn sort_group<P: Copy>(
         return;
     }
     let buckets = len * SORT_SPREAD;
-    let (scale, last) = (buckets as f64, buckets as u32 - 1);
+    let (scale, top) = (buckets as f64, buckets as u32 - 1);
     local.clear();
     local.extend(
         group
             .iter()
-            .map(|s| ((within(s.rank) * scale) as u32).min(last)),
+            .map(|s| ((in_group(s.rank) * scale) as u32).min(top)),
     );
     start.clear();
     start.resize(buckets + 1, 0);
@@ -988,14 +988,14 @@ fn sort_group<P: Copy>(
         *at += 1;
     }
     // nearly sorted: a sample moves back past the few of its own bucket
-    // with a larger rank (strictly larger: ties keep their order); `last`,
+    // with a larger rank (strictly larger: ties keep their order); `largest`,
     // the largest rank placed so far, keeps the common case from reading
     // back what it just wrote
-    let (mut last, mut moves) = (f64::NEG_INFINITY, 0);
+    let (mut largest, mut moves) = (f64::NEG_INFINITY, 0);
     for (i, &s) in scratch.iter().enumerate() {
-        if s.rank >= last {
+        if s.rank >= largest {
             group[i] = s;
-            last = s.rank;
+            largest = s.rank;
             continue;
         }
         let mut j = i;
