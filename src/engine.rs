@@ -42,9 +42,11 @@
 //! [`Order::Unsorted`], finds only which to keep.
 
 use crate::density::{Density, Region};
+use crate::memory;
 use crate::tiling::{code_value, Code, TileSystem};
 use crate::Error;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// A generated sample.
 ///
@@ -145,9 +147,10 @@ where
 }
 
 /// The accepted samples of each root's subtree, in root order, into
-/// `parts` (one list per root, their memory reused); with `histograms`,
-/// also each root's count of samples per rank bucket, taken while its
-/// samples are still in cache. False when some rank lies outside `[0, 1)`
+/// `parts` (a list per run of consecutive roots, see [`chunk_roots`];
+/// their memory reused); with `histograms`, also each list's count of
+/// samples per rank bucket, taken while each root's samples are still in
+/// cache. False when some rank lies outside `[0, 1)`
 /// (never for the engine's ranks; not checked without `histograms`).
 fn collect_parts<S, D>(
     system: &S,
@@ -177,38 +180,82 @@ where
         window,
     };
     let roots = system.roots();
-    // room for about a root's share (by the density's average over it), so
-    // that few outputs regrow: a guess, capped so that a wrong one (or a
-    // window's small part of a huge request) reserves little
-    let share = |root: &S::Tile| {
-        if window.is_some() {
-            return 16;
-        }
-        let average = walker
-            .constant
-            .unwrap_or_else(|| density.average(&system.region(root)));
-        let expected = magnitude * (average / walker.mean) / roots.len() as f64;
-        (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
-    };
-    parts.resize_with(roots.len(), Vec::new);
+    // about a root's share of the samples (by the density's average over
+    // it): a guess, capped so that a wrong one (or a window's small part
+    // of a huge request) reserves little
+    let shares: Vec<usize> = roots
+        .iter()
+        .map(|root| {
+            if window.is_some() {
+                return 16;
+            }
+            let average = walker
+                .constant
+                .unwrap_or_else(|| density.average(&system.region(root)));
+            let expected = magnitude * (average / walker.mean) / roots.len() as f64;
+            (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
+        })
+        .collect();
+    let chunks = chunk_roots(&shares, window.is_some(), size_of::<Sample<S::Point>>());
+    parts.resize_with(chunks.len(), Vec::new);
     let (buckets, mut none) = (histograms.as_ref().map(|h| h.0), Vec::new());
     let counts = histograms.map_or(&mut none, |h| h.1);
-    counts.resize_with(roots.len(), Vec::new);
-    roots
+    counts.resize_with(chunks.len(), Vec::new);
+    chunks
         .par_iter()
         .zip(parts.par_iter_mut())
         .zip(counts.par_iter_mut())
-        .map(|((root, out), counts)| {
+        .map(|((chunk, out), counts)| {
             out.clear();
-            out.reserve(share(root));
-            walker.visit(root, f64::INFINITY, out);
             counts.clear();
-            buckets.is_none_or(|buckets| buckets.count_into(out, counts))
+            // room for the chunk's shares, so that few outputs regrow (a
+            // hint: a refused reservation leaves the list to grow)
+            let _ = memory::try_reserve_large(out, shares[chunk.clone()].iter().sum());
+            let mut in_range = true;
+            for root in &roots[chunk.clone()] {
+                let from = out.len();
+                walker.visit(root, f64::INFINITY, out);
+                // counted while the root's samples are still in cache
+                in_range &= buckets.is_none_or(|b| b.count_into(&out[from..], counts));
+            }
+            in_range
         })
         .reduce(|| true, |a, b| a && b)
 }
 
-/// The rank buckets of the per-root histograms the ranking starts from:
+/// Consecutive roots whose outputs share a list, by their expected sizes
+/// (`shares`): lists of at least [`CHUNK_BYTES`], about 8 a thread when
+/// the request is larger. Fresh large lists are backed by huge pages (see
+/// [`memory`]), where a list a root cost a page fault per 4 KB: taking
+/// 2 * 10^6 samples on a ramp into fresh memory spent about a third of its
+/// time in the kernel. A window's roots keep a list each: their shares are
+/// unknown, and a lone root must not hold up the others.
+fn chunk_roots(shares: &[usize], window: bool, sample_bytes: usize) -> Vec<Range<usize>> {
+    if window {
+        return (0..shares.len()).map(|r| r..r + 1).collect();
+    }
+    let total: usize = shares.iter().sum();
+    let per_thread = total / (8 * rayon::current_num_threads());
+    let target = per_thread.max(CHUNK_BYTES / sample_bytes.max(1));
+    let mut chunks = Vec::new();
+    let (mut start, mut size) = (0, 0);
+    for (r, &share) in shares.iter().enumerate() {
+        size += share;
+        if size >= target {
+            chunks.push(start..r + 1);
+            (start, size) = (r + 1, 0);
+        }
+    }
+    if start < shares.len() {
+        chunks.push(start..shares.len());
+    }
+    chunks
+}
+
+/// The smallest list [`chunk_roots`] gathers: two huge pages.
+const CHUNK_BYTES: usize = 4 << 20;
+
+/// The rank buckets of the per-list histograms the ranking starts from:
 /// bucket `b` holds the ranks in `[b, b + 1) / count`, ranks below 0 going
 /// to the first and from 1 on to the last (monotone in the rank).
 #[derive(Clone, Copy)]
@@ -218,7 +265,7 @@ struct RankBuckets {
 
 impl RankBuckets {
     /// About 2048 samples a bucket for `magnitude` samples (a group that
-    /// [`sort_group`] sorts in cache), 16 to 4096 buckets (a root's
+    /// [`sort_group`] sorts in cache), 16 to 4096 buckets (a list's
     /// histogram stays within 16 KB).
     fn for_magnitude(magnitude: f64) -> Self {
         RankBuckets {
@@ -231,11 +278,10 @@ impl RankBuckets {
         ((rank * self.count as f64) as usize).min(self.count - 1)
     }
 
-    /// The samples per bucket, into `counts` (left empty for no samples, so
-    /// that the empty roots of a window cost nothing); false when a rank
-    /// lies outside `[0, 1)`.
+    /// Adds the samples per bucket to `counts` (left empty while no samples
+    /// came, so that the empty roots of a window cost nothing); false when
+    /// a rank lies outside `[0, 1)`.
     fn count_into<P>(&self, samples: &[Sample<P>], counts: &mut Vec<u32>) -> bool {
-        counts.clear();
         if samples.is_empty() {
             return true;
         }
@@ -248,7 +294,7 @@ impl RankBuckets {
         in_range
     }
 
-    /// The histograms' sum: samples per bucket over every root.
+    /// The histograms' sum: samples per bucket over every list.
     fn total(&self, histograms: &[Vec<u32>]) -> Vec<usize> {
         let mut counts = vec![0usize; self.count];
         for histogram in histograms {
@@ -260,7 +306,7 @@ impl RankBuckets {
     }
 }
 
-/// The most samples a root's output reserves before it knows its count
+/// The most samples reserved for a root's output before it is known
 /// (24 MB of planar samples).
 const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
 
@@ -615,10 +661,10 @@ where
 }
 
 /// Memory a caller keeps between requests (see [`generate_into`]): the
-/// samples of the last request, and the per-root lists the recursion fills
-/// before ranking them. Fresh memory costs a page fault per 4 KB on first
-/// touch, about as much time as the sampling itself on large requests;
-/// reused buffers pay it once, and are overwritten without first being
+/// samples of the last request, and the lists the recursion fills before
+/// ranking them. Fresh memory costs page faults on first touch (one per
+/// 4 KB, or per 2 MB where large lists get huge pages), a third of a
+/// large request's time or more; reused buffers pay them once, and are overwritten without first being
 /// cleared. They hold about twice the samples' size.
 ///
 /// # Example
@@ -637,7 +683,7 @@ where
 pub struct Buffers<P> {
     samples: Vec<Sample<P>>,
     parts: Vec<Vec<Sample<P>>>,
-    /// Per root: samples per rank bucket (unsorted requests).
+    /// Per list of `parts`: samples per rank bucket.
     histograms: Vec<Vec<u32>>,
 }
 
@@ -755,10 +801,7 @@ where
         );
     }
     // refuse, rather than abort on, a request whose output cannot be held
-    if out
-        .try_reserve_exact(count.saturating_sub(out.len()))
-        .is_err()
-    {
+    if memory::try_reserve_large(out, count.saturating_sub(out.len())).is_err() {
         return refuse(
             out,
             format!(
@@ -820,8 +863,8 @@ where
 
 /// The `keep` samples of smallest rank (all when fewer), into `out`
 /// (replacing its contents): the set [`by_rank`] keeps, ties included,
-/// without sorting it. The roots' histograms (`buckets` of each root's
-/// part) find the bucket holding the cut; one pass copies the samples
+/// without sorting it. The lists' histograms (`buckets` of each list
+/// of `parts`) find the bucket holding the cut; one pass copies the samples
 /// below it in root order and sets that bucket's aside, of which the
 /// smallest follow, in rank order.
 fn smallest_ranks<P: Copy>(
@@ -866,7 +909,7 @@ fn smallest_ranks<P: Copy>(
 
 /// The `keep` samples of smallest rank (all when fewer), ordered by rank,
 /// into `out` (replacing its contents); ties keep their deterministic root
-/// order (as a stable sort would). `histograms` count each root's ranks;
+/// order (as a stable sort would). `histograms` count each list's ranks;
 /// `in_range` says every rank lies in `[0, 1)`.
 fn by_rank<P: Copy + Send + Sync>(
     parts: &[Vec<Sample<P>>],
@@ -921,6 +964,10 @@ fn sort_by_groups<P: Copy + Send + Sync>(
     let used = start.partition_point(|&end| end < keep.min(n)).min(groups);
     let ends: Vec<usize> = start[1..=used].to_vec();
     // (every slot is written below: only new memory needs a fill)
+    if out.capacity() < start[used] {
+        out.clear();
+        let _ = memory::try_reserve_large(out, start[used]);
+    }
     out.truncate(start[used]);
     out.resize(start[used], first);
     // `start[g]` moves to the end of group g while filling

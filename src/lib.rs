@@ -21,6 +21,7 @@ mod error;
 pub mod healpix;
 pub mod io;
 pub mod lut;
+mod memory;
 pub mod metrics;
 pub mod optimize;
 mod sampler;
