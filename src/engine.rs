@@ -1266,5 +1266,27 @@ mod tests {
             head.sort_by_key(|s| s.position);
             prop_assert_eq!(unsorted, [head, tail].concat());
         }
+
+        /// The output lists cover every root once, in order; each but the
+        /// last holds at least the target share, and only a window keeps a
+        /// list a root.
+        #[test]
+        fn roots_share_lists_in_order(
+            shares in prop::collection::vec(0usize..400_000, 1..300),
+            window in any::<bool>(),
+        ) {
+            let chunks = chunk_roots(&shares, window, 24);
+            let covered: Vec<usize> = chunks.iter().flat_map(|c| c.clone()).collect();
+            prop_assert_eq!(covered, (0..shares.len()).collect::<Vec<_>>());
+            prop_assert!(chunks.iter().all(|c| !c.is_empty()));
+            if window {
+                prop_assert_eq!(chunks.len(), shares.len());
+            } else {
+                let least = CHUNK_BYTES / 24;
+                for c in &chunks[..chunks.len() - 1] {
+                    prop_assert!(shares[c.clone()].iter().sum::<usize>() >= least);
+                }
+            }
+        }
     }
 }

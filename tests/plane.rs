@@ -294,7 +294,14 @@ fn unsorted_keeps_the_progressive_samples<S>(
         });
         s
     };
-    for (n, exact) in [(1, true), (3000, true), (3000, false), (20_000, true)] {
+    // (400 000 samples fill several of the engine's output lists)
+    for (n, exact) in [
+        (1, true),
+        (3000, true),
+        (3000, false),
+        (20_000, true),
+        (400_000, true),
+    ] {
         let progressive = run(n, exact, Order::Progressive);
         let unsorted = common::on_threads(1, || run(n, exact, Order::Unsorted));
         let on_two = common::on_threads(2, || run(n, exact, Order::Unsorted));
