@@ -196,7 +196,7 @@ where
             (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
         })
         .collect();
-    let chunks = chunk_roots(&shares, window.is_some(), size_of::<Sample<S::Point>>());
+    let chunks = chunk_roots(&shares, window.is_some(), rayon::current_num_threads());
     parts.resize_with(chunks.len(), Vec::new);
     let (buckets, mut none) = (histograms.as_ref().map(|h| h.0), Vec::new());
     let counts = histograms.map_or(&mut none, |h| h.1);
@@ -224,19 +224,16 @@ where
 }
 
 /// Consecutive roots whose outputs share a list, by their expected sizes
-/// (`shares`): lists of at least [`CHUNK_BYTES`], about 8 a thread when
-/// the request is larger. Fresh large lists are backed by huge pages (see
-/// [`memory`]), where a list a root cost a page fault per 4 KB: taking
+/// (`shares`): about 4 lists a thread, so that a large request's lists are
+/// large enough for huge pages (see [`memory`]; with a list a root, taking
 /// 2 * 10^6 samples on a ramp into fresh memory spent about a third of its
-/// time in the kernel. A window's roots keep a list each: their shares are
-/// unknown, and a lone root must not hold up the others.
-fn chunk_roots(shares: &[usize], window: bool, sample_bytes: usize) -> Vec<Range<usize>> {
+/// time in page faults) while the threads still share the work. A window's
+/// roots keep a list each: their shares are unknown.
+fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usize>> {
     if window {
         return (0..shares.len()).map(|r| r..r + 1).collect();
     }
-    let total: usize = shares.iter().sum();
-    let per_thread = total / (8 * rayon::current_num_threads());
-    let target = per_thread.max(CHUNK_BYTES / sample_bytes.max(1));
+    let target = (shares.iter().sum::<usize>() / (4 * threads.max(1))).max(1);
     let mut chunks = Vec::new();
     let (mut start, mut size) = (0, 0);
     for (r, &share) in shares.iter().enumerate() {
@@ -251,9 +248,6 @@ fn chunk_roots(shares: &[usize], window: bool, sample_bytes: usize) -> Vec<Range
     }
     chunks
 }
-
-/// The smallest list [`chunk_roots`] gathers: two huge pages.
-const CHUNK_BYTES: usize = 4 << 20;
 
 /// The rank buckets of the per-list histograms the ranking starts from:
 /// bucket `b` holds the ranks in `[b, b + 1) / count`, ranks below 0 going
@@ -1268,21 +1262,22 @@ mod tests {
         }
 
         /// The output lists cover every root once, in order; each but the
-        /// last holds at least the target share, and only a window keeps a
-        /// list a root.
+        /// last holds at least a quarter of a thread's share, and only a
+        /// window keeps a list a root.
         #[test]
         fn roots_share_lists_in_order(
             shares in prop::collection::vec(0usize..400_000, 1..300),
             window in any::<bool>(),
+            threads in 1usize..5,
         ) {
-            let chunks = chunk_roots(&shares, window, 24);
+            let chunks = chunk_roots(&shares, window, threads);
             let covered: Vec<usize> = chunks.iter().flat_map(|c| c.clone()).collect();
             prop_assert_eq!(covered, (0..shares.len()).collect::<Vec<_>>());
             prop_assert!(chunks.iter().all(|c| !c.is_empty()));
             if window {
                 prop_assert_eq!(chunks.len(), shares.len());
             } else {
-                let least = CHUNK_BYTES / 24;
+                let least = shares.iter().sum::<usize>() / (4 * threads);
                 for c in &chunks[..chunks.len() - 1] {
                     prop_assert!(shares[c.clone()].iter().sum::<usize>() >= least);
                 }
