@@ -224,16 +224,17 @@ where
 }
 
 /// Consecutive roots whose outputs share a list, by their expected sizes
-/// (`shares`): about 4 lists a thread, so that a large request's lists are
-/// large enough for huge pages (see [`memory`]; with a list a root, taking
-/// 2 * 10^6 samples on a ramp into fresh memory spent about a third of its
-/// time in page faults) while the threads still share the work. A window's
+/// (`shares`): about [`LISTS_A_THREAD`] lists a thread, so that a large
+/// request's lists are large enough for huge pages (see [`memory`]; with a
+/// list a root, taking 2 * 10^6 samples on a ramp into fresh memory spent
+/// about a third of its time in page faults) while the threads still share
+/// the work. A window's
 /// roots keep a list each: their shares are unknown.
 fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usize>> {
     if window {
         return (0..shares.len()).map(|r| r..r + 1).collect();
     }
-    let target = (shares.iter().sum::<usize>() / (4 * threads.max(1))).max(1);
+    let target = (shares.iter().sum::<usize>() / (LISTS_A_THREAD * threads.max(1))).max(1);
     let mut chunks = Vec::new();
     let (mut start, mut size) = (0, 0);
     for (r, &share) in shares.iter().enumerate() {
@@ -248,6 +249,12 @@ fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usiz
     }
     chunks
 }
+
+/// Output lists a thread in [`chunk_roots`]. In scratch runs of a
+/// 10^6-sample spherical cap on 2 threads (interleaved, best of 8), 8 a
+/// thread ran as fast as a list a root, 4 about 5 % slower (likely a thread left
+/// alone with the last large list) and 64 slower again.
+const LISTS_A_THREAD: usize = 8;
 
 /// The rank buckets of the per-list histograms the ranking starts from:
 /// bucket `b` holds the ranks in `[b, b + 1) / count`, ranks below 0 going
@@ -1262,7 +1269,7 @@ mod tests {
         }
 
         /// The output lists cover every root once, in order; each but the
-        /// last holds at least a quarter of a thread's share, and only a
+        /// last holds at least its fraction of a thread's share, and only a
         /// window keeps a list a root.
         #[test]
         fn roots_share_lists_in_order(
@@ -1277,7 +1284,7 @@ mod tests {
             if window {
                 prop_assert_eq!(chunks.len(), shares.len());
             } else {
-                let least = shares.iter().sum::<usize>() / (4 * threads);
+                let least = shares.iter().sum::<usize>() / (LISTS_A_THREAD * threads);
                 for c in &chunks[..chunks.len() - 1] {
                     prop_assert!(shares[c.clone()].iter().sum::<usize>() >= least);
                 }
