@@ -228,8 +228,7 @@ where
 /// request's lists are large enough for huge pages (see [`memory`]; with a
 /// list a root, taking 2 * 10^6 samples on a ramp into fresh memory spent
 /// about a third of its time in page faults) while the threads still share
-/// the work. A window's
-/// roots keep a list each: their shares are unknown.
+/// the work. A window's roots keep a list each: their shares are unknown.
 fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usize>> {
     if window {
         return (0..shares.len()).map(|r| r..r + 1).collect();
@@ -252,8 +251,8 @@ fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usiz
 
 /// Output lists a thread in [`chunk_roots`]. In scratch runs of a
 /// 10^6-sample spherical cap on 2 threads (interleaved, best of 8), 8 a
-/// thread ran as fast as a list a root, 4 about 5 % slower (likely a thread left
-/// alone with the last large list) and 64 slower again.
+/// thread ran as fast as a list a root, 4 about 5 % slower (likely a
+/// thread left alone with the last large list) and 64 slower again.
 const LISTS_A_THREAD: usize = 8;
 
 /// The rank buckets of the per-list histograms the ranking starts from:
