@@ -5,7 +5,8 @@
 //! Fresh memory costs a page fault per 4 KB page on first touch: writing a
 //! new 48 MB buffer took 18 ms, against 5 ms once the buffer was marked for
 //! 2 MB pages (a scratch program, min of 10 runs). Requests of millions of
-//! samples write that much, so their output and per-root lists are marked.
+//! samples write that much, so their output and the recursion's lists are
+//! marked.
 
 use std::collections::TryReserveError;
 
@@ -14,8 +15,9 @@ use std::collections::TryReserveError;
 const SMALLEST_ADVISED: usize = 4 << 20;
 
 /// [`Vec::try_reserve_exact`] (into a new allocation when `buffer` is
-/// empty), then a request for huge pages over the buffer when it is large. The request is a hint: where it is refused or
-/// unsupported, the buffer is ordinary memory.
+/// empty), then a request for huge pages over the buffer when it is large.
+/// The request is a hint: where it is refused or unsupported, the buffer is
+/// ordinary memory.
 pub(crate) fn try_reserve_large<T>(
     buffer: &mut Vec<T>,
     additional: usize,
@@ -39,8 +41,9 @@ fn advise_huge_pages<T>(buffer: &mut Vec<T>) {
     if bytes < SMALLEST_ADVISED {
         return;
     }
-    // the whole pages inside the allocation (`madvise` takes page-aligned
-    // ranges; the allocator's header shares the first page)
+    // the whole 4 KB pages inside the allocation (`madvise` takes
+    // page-aligned ranges; the allocator's header shares the first page;
+    // on a system of larger pages the range is refused, which is harmless)
     const PAGE: usize = 4096;
     let start = buffer.as_mut_ptr() as usize;
     let (lo, hi) = (start.next_multiple_of(PAGE), (start + bytes) / PAGE * PAGE);
