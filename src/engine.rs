@@ -744,7 +744,7 @@ pub enum Order {
     /// spatially coherent, but for the kept samples of the last rank
     /// bucket, which come last in rank order: about 2048 of a large
     /// request, about a sixteenth of a small one; or rank order where
-    /// that is what comes out). It skips the ranking sort, about a quarter
+    /// that is what comes out). It skips the ranking sort, about a fifth
     /// of a large request's time, for callers that use the whole set.
     /// Deterministic, and independent of the thread count.
     Unsorted,
