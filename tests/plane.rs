@@ -42,6 +42,40 @@ fn uniform_4096_is_blue_noise() {
     }
 }
 
+/// Counts on both sides of the level boundaries (the G-hexomino's levels
+/// hold 216, 17,496 and 1,417,176 tiles; the P-pentomino's 20 * 4^k), where
+/// a parent keeps one or two children and shared offsets are weakest.
+#[test]
+fn uniform_sets_stay_spread_between_levels() {
+    let counts = [
+        300, 500, 700, 1000, 2000, 4096, 8000, 17_000, 18_000, 20_000, 25_000, 30_000, 40_000,
+        50_000,
+    ];
+    for (system, tiling) in systems() {
+        let (mut worst_min, mut worst_low) = ((f64::INFINITY, 0), (0.0f64, 0));
+        for n in counts {
+            let points = positions(&tiling, &Uniform, n);
+            let (d, low) = (min_distance(&points), low_frequency_power(&points));
+            if d < worst_min.0 {
+                worst_min = (d, n);
+            }
+            if low > worst_low.0 {
+                worst_low = (low, n);
+            }
+        }
+        println!(
+            "{}: worst min distance {:.3} (N = {}), worst low-frequency power {:.3} (N = {})",
+            system.name(),
+            worst_min.0,
+            worst_min.1,
+            worst_low.0,
+            worst_low.1
+        );
+        assert!(worst_min.0 >= 0.45, "{}: {worst_min:?}", system.name());
+        assert!(worst_low.0 <= 0.2, "{}: {worst_low:?}", system.name());
+    }
+}
+
 #[test]
 fn ramp_counts_follow_the_density() {
     let n = 40_000;
@@ -618,7 +652,9 @@ fn cli_samples_a_png_file_and_its_inverse() {
 /// How far the offset tables carry points beyond their tile's bounding box,
 /// in cells, over every tile of the first levels and 40 density fractions
 /// (printed with `--nocapture`): the planar tables are relaxed without a
-/// room around the tile, so points may leave it.
+/// room around the tile, so points may leave it. The G-hexomino's go
+/// furthest at its lowest fractions, where one point in 40 to 81 tiles is
+/// kept and the kept points lie about 20 cells apart.
 #[test]
 fn offsets_stay_near_their_tiles() {
     for (system, tiling) in systems() {
@@ -639,7 +675,7 @@ fn offsets_stay_near_their_tiles() {
             }
         }
         eprintln!("{system:?}: points reach {worst:.2} cells beyond their tile's box");
-        let bound = if tiling.lut().arity() == 4 { 3.0 } else { 8.0 };
+        let bound = if tiling.lut().arity() == 4 { 3.0 } else { 11.0 };
         assert!(worst < bound, "{system:?}: {worst}");
     }
 }

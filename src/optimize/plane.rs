@@ -11,15 +11,21 @@
 //!    every rule at once, to the children whose tiles lie farthest from the
 //!    tiles of digits `0..k` (maximin over all instances), so every threshold
 //!    keeps a well-spread subset; roots are ranked farthest-point first;
-//! 4. structural indices: the automaton whose state is the rule of the
-//!    ancestor `depth` levels up and the child numbers since (the tile's
-//!    position inside that ancestor, which fixes its neighbourhood except at
-//!    the ancestor's border); shallower tiles have their own states; the
-//!    report gives how often tiles of one state share one neighbourhood;
+//! 4. structural indices: the automaton whose state is the tile's depth
+//!    below the roots (up to `depth`), the rule of its ancestor `memory`
+//!    levels up and the child numbers since (the tile's position inside
+//!    that ancestor, which fixes its neighbourhood except at the ancestor's
+//!    border); the report gives how often tiles of one state share one
+//!    neighbourhood;
 //! 5. offsets per (structural index, importance bin): Lloyd relaxation of the
-//!    tiles a bin's density fraction accepts, every state sharing one offset;
+//!    tiles a bin's density fraction accepts, every state sharing one offset,
+//!    each depth on its own level (the deepest on the deepest level up to
+//!    `lloyd_level` that holds at most `max_sites` of the bin's sites; where
+//!    none does, its states take the offsets of their twins one depth up);
 //!    then a few separation steps push apart the rare close pairs that shared
-//!    offsets leave where a state meets an unusual neighbourhood.
+//!    offsets leave where a state meets an unusual neighbourhood. Depths
+//!    matter where the neighbourhoods differ: the G-hexomino's children of
+//!    roots sit in the root patch's arrangement, deeper tiles in the rule's.
 
 use crate::baselines::SplitMix64;
 use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
@@ -56,11 +62,16 @@ pub struct BuildOptions {
     /// up to this depth (a child of a root sits in a different
     /// neighbourhood than a child of an inner tile).
     pub depth: u32,
+    /// Child numbers a structural index remembers (at most `depth`): the
+    /// tile's position inside its ancestor this many levels up.
+    pub memory: u32,
     /// Level on which the deepest structural indices are relaxed.
     pub lloyd_level: u32,
     /// Largest number of sites relaxed at once; a bin with more sites at
     /// `lloyd_level` is relaxed on the deepest level that fits (at least
-    /// `depth`).
+    /// `depth`; where even that holds more, the deepest states take their
+    /// twins' offsets one depth up, or are relaxed there anyway if some
+    /// have no twin).
     pub max_sites: usize,
     /// Quadrature points per site in Lloyd relaxation.
     pub quadrature: usize,
@@ -84,8 +95,9 @@ impl BuildOptions {
                 seed: 1,
                 iterations: 24,
                 bins: 81,
-                depth: 1,
-                lloyd_level: 1,
+                depth: 2,
+                memory: 1,
+                lloyd_level: 2,
                 max_sites: 80_000,
                 quadrature: 24,
                 relaxation: 1.5,
@@ -96,6 +108,7 @@ impl BuildOptions {
                 iterations: 24,
                 bins: 25,
                 depth: 3,
+                memory: 3,
                 lloyd_level: 4,
                 max_sites: 80_000,
                 quadrature: 40,
@@ -126,7 +139,8 @@ pub struct BuildReport {
     /// `child_rule` search: centroid spread (min + mean NN distance, cells
     /// at three levels down) of the chosen assignment.
     pub rule_score: f64,
-    /// Mean site move (cells) in the last Lloyd iteration, per bin.
+    /// Mean site move (cells) in the last Lloyd iteration, per bin (of the
+    /// deepest states, or of their twins where those lend their offsets).
     pub lloyd_residual: Vec<f64>,
     /// Seconds spent in Lloyd relaxation.
     pub lloyd_seconds: f64,
@@ -162,9 +176,13 @@ pub fn build(
 ) -> Result<(PlaneLut, BuildReport), Error> {
     let (shape, rules) = stored_rules(system)?;
     let arity = rules[0].children.len();
-    if options.bins < 2 || options.depth == 0 || options.lloyd_level < options.depth {
+    if options.bins < 2
+        || options.depth == 0
+        || options.lloyd_level < options.depth
+        || !(1..=options.depth).contains(&options.memory)
+    {
         return Err(Error::Request(
-            "need at least 2 bins and 1 <= depth <= lloyd_level".into(),
+            "need at least 2 bins, 1 <= depth <= lloyd_level and 1 <= memory <= depth".into(),
         ));
     }
     let mut rng = SplitMix64::new(options.seed);
@@ -191,7 +209,7 @@ pub fn build(
     progress("ranks", 0, 1);
     choose_digits(&mut lut);
     lut.root_rank = root_ranks(&lut);
-    let depths = build_automaton(&mut lut, options.depth);
+    let (depths, shallower) = build_automaton(&mut lut, options.depth, options.memory);
     lut.bins = options.bins;
     let centroid = PlaneLut::quantise(shape.centroid());
     lut.offsets = vec![centroid; lut.classes() * options.bins as usize];
@@ -204,17 +222,42 @@ pub fn build(
     let started = Instant::now();
     let mut residuals = Vec::new();
     let deepest = options.depth;
+    // the deepest states can take their shallower twins' offsets where a
+    // bin has too many sites to relax at their depth
+    let twinned = depths
+        .iter()
+        .zip(&shallower)
+        .all(|(&d, twin)| d < deepest || twin.is_some());
     for bin in 0..options.bins as usize {
         progress("lloyd", bin as u64, options.bins as u64);
+        let mut shallower_residual = 0.0;
         for depth in 0..deepest {
-            relax(&mut lut, &depths, depth, depth, bin, options);
+            shallower_residual = relax(&mut lut, &depths, depth, depth, bin, options);
         }
         let sites = |l: u32| lut.bin_fraction(bin) * tiling.capacity(l);
         let level = (deepest..=options.lloyd_level)
             .rev()
-            .find(|&l| sites(l) <= options.max_sites as f64)
-            .unwrap_or(deepest);
-        residuals.push(relax(&mut lut, &depths, deepest, level, bin, options));
+            .find(|&l| sites(l) <= options.max_sites as f64);
+        let residual = match level {
+            None if twinned => {
+                let bins = options.bins as usize;
+                for (state, twin) in shallower.iter().enumerate() {
+                    if let Some(twin) = *twin {
+                        lut.offsets[state * bins + bin] = lut.offsets[twin as usize * bins + bin];
+                    }
+                }
+                shallower_residual
+            }
+            _ => relax(
+                &mut lut,
+                &depths,
+                deepest,
+                level.unwrap_or(deepest),
+                bin,
+                options,
+            ),
+        };
+        residuals.push(residual);
     }
     progress("lloyd", options.bins as u64, options.bins as u64);
     let report = BuildReport {
@@ -413,9 +456,11 @@ fn root_ranks(lut: &PlaneLut) -> Vec<u32> {
 }
 
 /// The structural-index automaton: a state is (depth below the roots, capped
-/// at `depth`; the rule of the ancestor that many levels up; the child
-/// numbers since). Returns each state's depth.
-fn build_automaton(lut: &mut PlaneLut, depth: u32) -> Vec<u32> {
+/// at `depth`; the rule of the ancestor up to `memory` levels up; the child
+/// numbers since). Returns each state's depth and, for states of depth
+/// `depth`, the state one depth up with the same rule and child numbers
+/// (when there is one).
+fn build_automaton(lut: &mut PlaneLut, depth: u32, memory: u32) -> (Vec<u32>, Vec<Option<u32>>) {
     type State = (u32, u8, Vec<u8>);
     let arity = lut.arity();
     let mut ids: HashMap<State, u32> = HashMap::new();
@@ -438,8 +483,9 @@ fn build_automaton(lut: &mut PlaneLut, depth: u32) -> Vec<u32> {
         for child in 0..arity as u8 {
             let mut p = path.clone();
             p.push(child);
-            let s = if d < depth {
-                (d + 1, rule, p)
+            let d = (d + 1).min(depth);
+            let s = if p.len() as u32 <= memory {
+                (d, rule, p)
             } else {
                 let ancestor = lut.child_rule[rule as usize][p[0] as usize];
                 (d, ancestor, p[1..].to_vec())
@@ -449,7 +495,14 @@ fn build_automaton(lut: &mut PlaneLut, depth: u32) -> Vec<u32> {
         next += 1;
     }
     lut.transitions = transitions;
-    states.iter().map(|s| s.0).collect()
+    let shallower = states
+        .iter()
+        .map(|(d, rule, path)| match *d {
+            d if d == depth && d > 0 => ids.get(&(d - 1, *rule, path.clone())).copied(),
+            _ => None,
+        })
+        .collect();
+    (states.iter().map(|s| s.0).collect(), shallower)
 }
 
 /// Share of the tiles of `level` whose neighbourhood is the most common one
