@@ -165,38 +165,26 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    let walker = Walker {
-        system,
-        density,
-        capacities: (0..=system.max_level() + 1)
-            .map(|level| system.capacity(level))
-            .collect(),
-        // thresholds compare codes, so the request goes in code units
-        magnitude: magnitude * system.codes_per_sample(),
-        mean: density.mean(),
-        per_mean: Some(magnitude * system.codes_per_sample() / density.mean())
-            .filter(|k| k.is_finite()),
-        constant: density.constant(),
-        window,
-    };
-    let roots = system.roots();
-    // about a root's share of the samples (by the density's average over
+    let walker = Walker::new(system, density, magnitude, window);
+    let threads = rayon::current_num_threads();
+    let starts = walker.starts(system.roots(), LISTS_A_THREAD * threads);
+    // about a start's share of the samples (by the density's average over
     // it): a guess, capped so that a wrong one (or a window's small part
     // of a huge request) reserves little
-    let shares: Vec<usize> = roots
+    let shares: Vec<usize> = starts
         .iter()
-        .map(|root| {
+        .map(|start| {
             if window.is_some() {
                 return 16;
             }
             let average = walker
                 .constant
-                .unwrap_or_else(|| density.average(&system.region(root)));
-            let expected = magnitude * (average / walker.mean) / roots.len() as f64;
+                .unwrap_or_else(|| density.average(&system.region(&start.tile)));
+            let expected = magnitude * (average / walker.mean) * start.share;
             (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
         })
         .collect();
-    let chunks = chunk_roots(&shares, window.is_some(), rayon::current_num_threads());
+    let chunks = chunk_roots(&shares, window.is_some(), threads);
     parts.resize_with(chunks.len(), Vec::new);
     let (buckets, mut none) = (histograms.as_ref().map(|h| h.0), Vec::new());
     let counts = histograms.map_or(&mut none, |h| h.1);
@@ -212,9 +200,9 @@ where
             // hint: a refused reservation leaves the list to grow)
             let _ = memory::try_reserve_large(out, shares[chunk.clone()].iter().sum());
             let mut in_range = true;
-            for root in &roots[chunk.clone()] {
+            for start in &starts[chunk.clone()] {
                 let from = out.len();
-                walker.visit(root, f64::INFINITY, out);
+                walker.visit(&start.tile, f64::INFINITY, out);
                 // counted while the root's samples are still in cache
                 in_range &= buckets.is_none_or(|b| b.count_into(&out[from..], counts));
             }
@@ -248,6 +236,18 @@ fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec<Range<usiz
     }
     chunks
 }
+
+/// A tile the recursion starts from (see [`Walker::starts`]).
+struct Start<T> {
+    tile: T,
+    /// About the tile's part of the domain (`1 / roots` for a root, split
+    /// evenly among children): a hint for the output's reservation.
+    share: f64,
+}
+
+/// Rounds of [`Walker::starts`]: enough for Penrose's single root, whose
+/// triangles have one to four children, to reach dozens of starts.
+const MAX_START_ROUNDS: usize = 12;
 
 /// Output lists a thread in [`chunk_roots`]. In scratch runs of a
 /// 10^6-sample spherical cap on 2 threads (interleaved, best of 8), 8 a
@@ -354,12 +354,34 @@ struct Walker<'a, S: TileSystem, D: ?Sized> {
     window: Option<&'a Window<'a, S::Region>>,
 }
 
-impl<S, D> Walker<'_, S, D>
+impl<'a, S, D> Walker<'a, S, D>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
+    fn new(
+        system: &'a S,
+        density: &'a D,
+        magnitude: f64,
+        window: Option<&'a Window<'a, S::Region>>,
+    ) -> Self {
+        // thresholds compare codes, so the request goes in code units
+        let magnitude = magnitude * system.codes_per_sample();
+        Walker {
+            system,
+            density,
+            capacities: (0..=system.max_level() + 1)
+                .map(|level| system.capacity(level))
+                .collect(),
+            magnitude,
+            mean: density.mean(),
+            per_mean: Some(magnitude / density.mean()).filter(|k| k.is_finite()),
+            constant: density.constant(),
+            window,
+        }
+    }
+
     /// A density value (a bound or an average) in code units: `value *
     /// magnitude / mean`. One multiply where `magnitude / mean` is finite
     /// (divisions on the chain from a tile's density to its sample's
@@ -371,6 +393,62 @@ where
             Some(k) => value * k,
             None => self.magnitude * (value / self.mean),
         }
+    }
+
+    /// The tiles to visit, in order: the roots, each replaced by its
+    /// children while there are fewer than `target` and it recurses into
+    /// every child with a bound that makes none of them terminal (so its
+    /// bound decides nothing for them: visiting them as roots is visiting
+    /// it); the output is the same, in the same order, but a system of few
+    /// roots (Penrose has one) gives every thread work. A window keeps the
+    /// roots.
+    fn starts(&self, roots: Vec<S::Tile>, target: usize) -> Vec<Start<S::Tile>> {
+        let share = 1.0 / roots.len().max(1) as f64;
+        let mut starts: Vec<Start<S::Tile>> = roots
+            .into_iter()
+            .map(|tile| Start { tile, share })
+            .collect();
+        if self.window.is_some() {
+            return starts;
+        }
+        for _ in 0..MAX_START_ROUNDS {
+            if starts.len() >= target {
+                break;
+            }
+            let before = starts.len();
+            let mut next = Vec::with_capacity(before * 4);
+            for start in starts {
+                if !self.recurses_into_all(&start.tile) {
+                    next.push(start);
+                    continue;
+                }
+                let count = self.system.child_count(&start.tile);
+                next.extend((0..count).map(|i| Start {
+                    tile: self.system.child(&start.tile, i),
+                    share: start.share / count as f64,
+                }));
+            }
+            starts = next;
+            if starts.len() == before {
+                break;
+            }
+        }
+        starts
+    }
+
+    /// Whether [`Walker::visit`] of a tile not terminal by its parent visits
+    /// every child, with a bound that makes none of them terminal.
+    fn recurses_into_all(&self, tile: &S::Tile) -> bool {
+        let level = self.system.level(tile);
+        if level >= self.system.max_level() {
+            return false;
+        }
+        let bound = match self.constant {
+            Some(c) => self.magnitude * (c / self.mean),
+            None => self.scaled(self.density.bound_and_average(&self.system.region(tile)).0),
+        };
+        // (false for a NaN bound, as for a zero one)
+        bound > 0.0 && self.capacities[level as usize + 1] < bound
     }
 
     /// `parent_bound`: the parent's scaled bound, which bounds this tile
@@ -1198,6 +1276,44 @@ where
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// Visiting the starts gives what visiting the roots gives, sample for
+    /// sample in the same order, and a single root becomes many starts.
+    #[test]
+    fn starts_visit_as_the_roots_do() {
+        use crate::density::{plane::Ramp, sphere::Cap, Uniform};
+        use crate::tiling::{penrose::PenroseTiling, sphere::SphereTiling};
+        fn check<S, D>(system: &S, density: &D, magnitudes: &[f64]) -> usize
+        where
+            S: TileSystem,
+            S::Point: PartialEq + std::fmt::Debug,
+            S::Region: Region<Point = S::Point>,
+            D: Density<S::Region>,
+        {
+            let mut most = 0;
+            for &magnitude in magnitudes {
+                let walker = Walker::new(system, density, magnitude, None);
+                let (mut by_roots, mut by_starts) = (Vec::new(), Vec::new());
+                for root in system.roots() {
+                    walker.visit(&root, f64::INFINITY, &mut by_roots);
+                }
+                let starts = walker.starts(system.roots(), 64);
+                most = most.max(starts.len());
+                for start in &starts {
+                    walker.visit(&start.tile, f64::INFINITY, &mut by_starts);
+                }
+                assert!(!by_roots.is_empty());
+                assert_eq!(by_roots, by_starts, "magnitude {magnitude}");
+            }
+            most
+        }
+        let magnitudes = [1.0, 10.0, 1000.0, 1e5];
+        let penrose = PenroseTiling::default();
+        assert!(check(&penrose, &Ramp, &magnitudes) >= 64);
+        assert!(check(&penrose, &Uniform, &magnitudes) >= 64);
+        let cap = Cap::new(10.0, 20.0, 5.0, 100.0).unwrap();
+        check(&SphereTiling::default(), &cap, &[10.0, 1e4]);
+    }
 
     proptest! {
         /// Ranking equals a stable sort of the concatenated parts by rank,
