@@ -575,6 +575,11 @@ impl TileSystem for PenroseTiling {
         tile.code
     }
 
+    // inlined, as the polyominoes' is: a density reading only the centroid
+    // (the ramp) then never computes the cells (with a second caller,
+    // `Walker::starts`, the compiler stopped inlining it and ramp requests
+    // ran 13 % slower)
+    #[inline(always)]
     fn region(&self, tile: &PenroseTile) -> PlaneRegion {
         let (lo, hi) = self.bounds(tile);
         let edge = self.edge[tile.level as usize];
