@@ -213,7 +213,7 @@ where
             for start in &starts[chunk.clone()] {
                 let from = out.len();
                 walker.visit(&start.tile, f64::INFINITY, out);
-                // counted while the root's samples are still in cache
+                // counted while the start's samples are still in cache
                 in_range &= buckets.is_none_or(|b| b.count_into(&out[from..], counts));
             }
             in_range
@@ -461,12 +461,25 @@ where
         if level >= self.system.max_level() {
             return false;
         }
-        let bound = match self.constant {
-            Some(c) => self.magnitude * (c / self.mean),
-            None => self.scaled(self.density.bound_and_average(&self.system.region(tile)).0),
-        };
+        let region = self.constant.is_none().then(|| self.system.region(tile));
+        let (bound, _) = self.own_bound(region.as_ref());
         // (false for a NaN bound, as for a zero one)
         bound > 0.0 && self.capacities[level as usize + 1] < bound
+    }
+
+    /// A tile's own scaled bound and, where the bound's work gives it, its
+    /// average ([`Density::bound_and_average`]); `region` may be `None` only
+    /// for a constant density.
+    #[inline(always)]
+    fn own_bound(&self, region: Option<&S::Region>) -> (f64, Option<f64>) {
+        match (self.constant, region) {
+            (Some(c), _) => (self.magnitude * (c / self.mean), Some(c)),
+            (None, Some(region)) => {
+                let (bound, average) = self.density.bound_and_average(region);
+                (self.scaled(bound), average)
+            }
+            (None, None) => unreachable!("a region exists whenever the density varies"),
+        }
     }
 
     /// `parent_bound`: the parent's scaled bound, which bounds this tile
@@ -508,15 +521,10 @@ where
     ) {
         let terminal_by_parent = capacity >= parent_bound;
         let (bound, average) = match (self.constant, region) {
-            (Some(c), _) => (self.magnitude * (c / self.mean), Some(c)),
             (None, Some(region)) if terminal_by_parent => {
                 (parent_bound, Some(self.density.average(region)))
             }
-            (None, Some(region)) => {
-                let (bound, average) = self.density.bound_and_average(region);
-                (self.scaled(bound), average)
-            }
-            (None, None) => unreachable!("a region exists whenever the density varies"),
+            _ => self.own_bound(region),
         };
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
