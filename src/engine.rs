@@ -328,36 +328,6 @@ impl RankBuckets {
 /// (24 MB of planar samples).
 const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
 
-/// Placements a tile straddling a contrast tries before it drops its
-/// sample: each after the first is for the density the previous one
-/// landed on.
-const PLACEMENT_TRIES: usize = 3;
-
-/// Largest ratio between the density a sample was placed for and the
-/// density it lands on for the placement to stand: about one importance
-/// bin of the shipped tables (adjacent bins are 1.05 to 1.13 apart). A
-/// sample placed for one density among samples placed for another is
-/// what clumped at contrast edges; 2 still left such pairs, 1.03 gave no
-/// better separation than 1.1.
-const PLACEMENT_TOLERANCE: f64 = 1.1;
-
-/// Largest ratio between a tile's average density and the density its
-/// sample lands on for the tile to count as smooth and keep its sample by
-/// the average (the exact integral over the tile). Beyond it the tile
-/// straddles a contrast and the density where its sample lands keeps it.
-/// Keeping by that one-point value everywhere (commit `d8dde94`) spread
-/// samples best at edges but raised the irradiance errors of `cargo run
-/// --release --example envmap` from 4.08e-3 and 5.41e-3 to 5.41e-3 and
-/// 6.05e-3. In scratch runs ratios of 1.25 to 2 kept the average rule's
-/// errors on a smooth sky, 1.5 with the least support-edge bias.
-const SMOOTH_RATIO: f64 = 1.5;
-
-/// Whether `a` and `b` are within a factor `ratio` of each other.
-#[inline(always)]
-fn within(ratio: f64, a: f64, b: f64) -> bool {
-    a * ratio >= b && b * ratio >= a
-}
-
 struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
@@ -368,6 +338,12 @@ struct Walker<'a, S: TileSystem, D: ?Sized> {
     /// `magnitude / mean`, when finite: see [`Walker::scaled`].
     per_mean: Option<f64>,
     constant: Option<f64>,
+    /// The least a code gains before it is compared with a density: 1/2
+    /// for a constant density (thresholds round), 0 for a varying one
+    /// (codes gain a dither in `[0, 1)`).
+    least_dither: f64,
+    /// The dither's seed ([`Density::seed`]).
+    seed: u64,
     /// Only tiles this accepts are visited (see [`collect_within`]).
     window: Option<&'a Window<'a, S::Region>>,
 }
@@ -396,6 +372,8 @@ where
             mean: density.mean(),
             per_mean: Some(magnitude / density.mean()).filter(|k| k.is_finite()),
             constant: density.constant(),
+            least_dither: if density.constant().is_some() { 0.5 } else { 0.0 },
+            seed: density.seed().unwrap_or(0).wrapping_mul(0x9E37_79B9_7F4A_7C15),
             window,
         }
     }
@@ -462,22 +440,18 @@ where
             return false;
         }
         let region = self.constant.is_none().then(|| self.system.region(tile));
-        let (bound, _) = self.own_bound(region.as_ref());
+        let bound = self.own_bound(region.as_ref());
         // (false for a NaN bound, as for a zero one)
         bound > 0.0 && self.capacities[level as usize + 1] < bound
     }
 
-    /// A tile's own scaled bound and, where the bound's work gives it, its
-    /// average ([`Density::bound_and_average`]); `region` may be `None` only
-    /// for a constant density.
+    /// A tile's own scaled bound; `region` may be `None` only for a
+    /// constant density.
     #[inline(always)]
-    fn own_bound(&self, region: Option<&S::Region>) -> (f64, Option<f64>) {
+    fn own_bound(&self, region: Option<&S::Region>) -> f64 {
         match (self.constant, region) {
-            (Some(c), _) => (self.magnitude * (c / self.mean), Some(c)),
-            (None, Some(region)) => {
-                let (bound, average) = self.density.bound_and_average(region);
-                (self.scaled(bound), average)
-            }
+            (Some(c), _) => self.magnitude * (c / self.mean),
+            (None, Some(region)) => self.scaled(self.density.bound(region)),
             (None, None) => unreachable!("a region exists whenever the density varies"),
         }
     }
@@ -490,7 +464,7 @@ where
         let level = self.system.level(tile);
         let capacity = self.capacities[level as usize];
         let terminal_by_parent = capacity >= parent_bound;
-        if terminal_by_parent && code_value(self.system.code(tile)) + 0.5 >= parent_bound {
+        if terminal_by_parent && code_value(self.system.code(tile)) + self.least_dither >= parent_bound {
             return;
         }
         // the region is built in place and lent (an `Option` of it would be
@@ -506,9 +480,9 @@ where
         }
     }
 
-    /// [`Walker::visit`] past its first tests: the tile's bound and
-    /// average decide whether it is terminal, and a terminal tile's code
-    /// whether it is kept; the others recurse.
+    /// [`Walker::visit`] past its first tests: the tile's bound decides
+    /// whether it is terminal, and a terminal tile's code and the density
+    /// where its sample lands whether it is kept; the others recurse.
     #[inline(always)]
     fn decide(
         &self,
@@ -519,12 +493,9 @@ where
         region: Option<&S::Region>,
         out: &mut Vec<Sample<S::Point>>,
     ) {
-        let terminal_by_parent = capacity >= parent_bound;
-        let (bound, average) = match (self.constant, region) {
-            (None, Some(region)) if terminal_by_parent => {
-                (parent_bound, Some(self.density.average(region)))
-            }
-            _ => self.own_bound(region),
+        let bound = match capacity >= parent_bound {
+            true => parent_bound,
+            false => self.own_bound(region),
         };
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
@@ -534,18 +505,10 @@ where
                 return;
             }
             let code = code_value(self.system.code(tile));
-            if code + 0.5 >= bound {
-                return; // not even the bound would keep it: skip the average
+            if code + self.least_dither >= bound {
+                return; // not even the bound would keep it
             }
-            let d = match (self.constant, average, region) {
-                (Some(_), _, _) => self.magnitude,
-                (None, Some(a), _) => self.scaled(a),
-                (None, None, Some(r)) => self.scaled(self.density.average_after_bound(r)),
-                (None, None, None) => {
-                    unreachable!("a region exists whenever the density varies")
-                }
-            };
-            return self.emit(tile, level, code, (d, bound), out);
+            return self.emit(tile, level, code, bound, out);
         }
         self.visit_children(tile, level, bound, out);
     }
@@ -564,36 +527,27 @@ where
         if self.window.is_some() || !self.system.carries_sample(tile) {
             return self.visit(tile, bound, out);
         }
-        let d = match self.constant {
-            Some(_) => self.magnitude,
-            None => self.scaled(self.density.average(&self.system.region(tile))),
-        };
-        self.emit(tile, level, code, (d, bound), out);
+        self.emit(tile, level, code, bound, out);
     }
 
-    /// Places the sample of a terminal tile of code `code`, average density
-    /// `d` and scaled bound `bound` (code units), if its code is kept (see
-    /// the module doc).
-    ///
-    /// The earlier rule kept every sample by the tile's average and placed
-    /// it for the average: at contrast edges, straddling tiles leaked
-    /// samples at the bright rate into the dim side, and samples placed
-    /// for one density sat among samples placed for another. The
-    /// contrast tests of `tests/properties.rs` print the separations on
-    /// random maps and beside a sun, which that rule made 3 to 60 times
-    /// smaller.
+    /// The per-tile dither of a varying density's threshold: uniform in
+    /// `[0, 1)`, a hash of the tile's code, its level and the density's
+    /// seed ([`Density::seed`]), so that it is random over seeds.
     #[inline(always)]
-    fn emit(
-        &self,
-        tile: &S::Tile,
-        level: u32,
-        code: f64,
-        (d, bound): (f64, f64),
-        out: &mut Vec<Sample<S::Point>>,
-    ) {
-        // a tile's code threshold sits mid-way through its unit of
-        // density, so sparse regions round instead of always keeping code 0
-        let keeps = |density: f64| code + 0.5 < density;
+    fn dither(&self, code: f64, level: u32) -> f64 {
+        // SplitMix64's finaliser (codes of dithered tiles lie below the
+        // bound, far below 2^64)
+        let mut z = (code as u64 ^ (u64::from(level) << 58)).wrapping_add(self.seed);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// Places the sample of a terminal tile of code `code` and scaled bound
+    /// `bound` (code units), if its code is kept (see the module doc).
+    #[inline(always)]
+    fn emit(&self, tile: &S::Tile, level: u32, code: f64, bound: f64, out: &mut Vec<Sample<S::Point>>) {
         // (the reciprocal keeps the division off the chain from the
         // density to the position)
         let per_tile = 1.0 / self.capacities[level as usize];
@@ -602,8 +556,11 @@ where
                 .sample_in_domain(tile, (density * per_tile).min(1.0))
         };
         if self.constant.is_some() {
-            // known before the sample is placed
-            if keeps(d) {
+            // known before the sample is placed: a code threshold sits
+            // mid-way through its unit of density, so the kept count is
+            // the request rounded
+            let d = self.magnitude;
+            if code + 0.5 < d {
                 if let Some(position) = place(d) {
                     out.push(Sample {
                         position,
@@ -613,62 +570,21 @@ where
             }
             return;
         }
-        if d.is_nan() || d <= 0.0 {
-            return; // a tile whose average is 0 carries nothing
-        }
-        if bound <= PLACEMENT_TOLERANCE * d && !keeps(d) {
-            // a tile whose bound is this close to its average is smooth,
-            // kept by the average: rejected without a placement (most
-            // tiles of a smooth density)
+        // thinning: placed for the bound, kept by the density it lands on
+        let threshold = code + self.dither(code, level);
+        if threshold >= bound {
             return;
         }
-        let landing = |density: f64| {
-            let position = place(density)?;
-            let here = self.scaled(self.density.value(position)).min(bound);
-            Some((position, if here.is_nan() { 0.0 } else { here }))
-        };
         // the tiling may reach past the domain: no sample there
-        let Some((position, here)) = landing(d) else {
+        let Some(position) = place(bound) else {
             return;
         };
-        if here > 0.0 && within(SMOOTH_RATIO, here, d) {
-            // a smooth tile: its average, an exact integral over the tile,
-            // keeps the sample; it is placed for the density it lands on
-            if !keeps(d) {
-                return;
-            }
-            let position = if within(PLACEMENT_TOLERANCE, d, here) {
-                position
-            } else {
-                landing(here)
-                    .filter(|&(_, there)| within(PLACEMENT_TOLERANCE, here, there))
-                    .map_or(position, |(p, _)| p)
-            };
-            return out.push(Sample {
+        let here = self.scaled(self.density.value(position));
+        if threshold < here {
+            out.push(Sample {
                 position,
-                rank: code / d,
+                rank: threshold / here,
             });
-        }
-        // a contrast inside the tile: from its bound down, the placement
-        // that lands on the density it was placed for, kept by that density
-        let mut guess = bound;
-        for _ in 0..PLACEMENT_TRIES {
-            let Some((position, here)) = landing(guess) else {
-                return;
-            };
-            if here <= 0.0 {
-                return; // off the support
-            }
-            if within(PLACEMENT_TOLERANCE, guess, here) {
-                if keeps(here) {
-                    out.push(Sample {
-                        position,
-                        rank: code / here,
-                    });
-                }
-                return;
-            }
-            guess = here;
         }
     }
 
@@ -691,7 +607,7 @@ where
                     break;
                 };
                 let code = code_value(self.system.child_code(tile, i));
-                if code + 0.5 >= bound {
+                if code + self.least_dither >= bound {
                     break;
                 }
                 self.visit_terminal(&self.system.child(tile, i), level + 1, code, bound, out);
@@ -699,7 +615,9 @@ where
             return;
         }
         for i in 0..count {
-            if child_rejects && code_value(self.system.child_code(tile, i)) + 0.5 >= bound {
+            if child_rejects
+                && code_value(self.system.child_code(tile, i)) + self.least_dither >= bound
+            {
                 continue;
             }
             self.visit(&self.system.child(tile, i), bound, out);

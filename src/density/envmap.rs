@@ -320,6 +320,8 @@ pub struct EnvMap {
     /// Z up and no rotation: face points are looked up from their `(z, phi)`
     /// directly, without building the direction.
     plain: bool,
+    /// The seed of `rotation`, when drawn from one.
+    seed: Option<u64>,
 }
 
 impl EnvMap {
@@ -377,6 +379,7 @@ impl EnvMap {
             up,
             rotation: DMat3::IDENTITY,
             plain: up == Up::Z,
+            seed: None,
         })
     }
 
@@ -416,6 +419,7 @@ impl EnvMap {
         EnvMap {
             rotation: random_rotation(seed),
             plain: false,
+            seed: Some(seed),
             ..self.clone()
         }
     }
@@ -749,20 +753,16 @@ impl Density<SphereRegion> for EnvMap {
         self.quadrature(region)
     }
 
-    fn bound_and_average(&self, region: &SphereRegion) -> (f64, Option<f64>) {
-        self.bound_in(region)
-    }
-
-    fn average_after_bound(&self, region: &SphereRegion) -> f64 {
-        self.quadrature(region)
-    }
-
     fn value(&self, point: DVec3) -> f64 {
         self.at(point)
     }
 
     fn mean(&self) -> f64 {
         self.pixels.integral / (4.0 * PI)
+    }
+
+    fn seed(&self) -> Option<u64> {
+        self.seed
     }
 }
 

@@ -1,8 +1,9 @@
 //! Importance functions ("densities") and their bounds over tiles.
 //!
-//! The engine asks a density two things about a tile: a conservative upper
-//! bound (to decide how deep to subdivide: a small bright region must never
-//! be skipped) and an average (to threshold the tile's code). Values are
+//! The engine asks a density two things: a conservative upper bound over a
+//! tile (to decide how deep to subdivide: a small bright region must never
+//! be skipped) and its value where the tile's sample lands (to threshold
+//! the tile's code). Averages serve size hints and callers. Values are
 //! relative: only ratios matter, and the engine scales by the requested count.
 
 pub mod envmap;
@@ -42,18 +43,8 @@ pub trait Density<R: Region>: Sync {
     fn bound(&self, region: &R) -> f64;
     /// The density's average over the region (may be approximate).
     fn average(&self, region: &R) -> f64;
-    /// The bound over the region and, when the bound's own work gives it
-    /// (the region lies where the density is constant), the exact average.
-    /// The engine calls this once per visited tile.
-    fn bound_and_average(&self, region: &R) -> (f64, Option<f64>) {
-        (self.bound(region), None)
-    }
-    /// The average over a region for which [`Density::bound_and_average`]
-    /// gave none: may skip the checks that function already made.
-    fn average_after_bound(&self, region: &R) -> f64 {
-        self.average(region)
-    }
-    /// The density at a point (used for pdfs).
+    /// The density at a point: where a tile's sample lands it keeps or
+    /// drops the sample, and it gives pdfs.
     fn value(&self, point: R::Point) -> f64;
     /// The average over the whole domain (its integral over the domain's
     /// measure), used to turn a sample count into a magnitude.
@@ -61,6 +52,12 @@ pub trait Density<R: Region>: Sync {
     /// `Some(c)` when the density is the constant `c` (lets the engine skip
     /// every bound and average).
     fn constant(&self) -> Option<f64> {
+        None
+    }
+    /// The seed of a randomised density (a random rotation or shift):
+    /// the engine draws its per-tile dithers from it, so that expectations
+    /// over seeds are exact. `None` for a fixed density.
+    fn seed(&self) -> Option<u64> {
         None
     }
 }
@@ -101,12 +98,6 @@ impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
     fn average(&self, region: &R) -> f64 {
         (**self).average(region)
     }
-    fn bound_and_average(&self, region: &R) -> (f64, Option<f64>) {
-        (**self).bound_and_average(region)
-    }
-    fn average_after_bound(&self, region: &R) -> f64 {
-        (**self).average_after_bound(region)
-    }
     fn value(&self, point: R::Point) -> f64 {
         (**self).value(point)
     }
@@ -115,5 +106,8 @@ impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
     }
     fn constant(&self) -> Option<f64> {
         (**self).constant()
+    }
+    fn seed(&self) -> Option<u64> {
+        (**self).seed()
     }
 }
