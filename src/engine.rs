@@ -372,8 +372,15 @@ where
             mean: density.mean(),
             per_mean: Some(magnitude / density.mean()).filter(|k| k.is_finite()),
             constant: density.constant(),
-            least_dither: if density.constant().is_some() { 0.5 } else { 0.0 },
-            seed: density.seed().unwrap_or(0).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+            least_dither: if density.constant().is_some() {
+                0.5
+            } else {
+                0.0
+            },
+            seed: density
+                .seed()
+                .unwrap_or(0)
+                .wrapping_mul(0x9E37_79B9_7F4A_7C15),
             window,
         }
     }
@@ -464,7 +471,9 @@ where
         let level = self.system.level(tile);
         let capacity = self.capacities[level as usize];
         let terminal_by_parent = capacity >= parent_bound;
-        if terminal_by_parent && code_value(self.system.code(tile)) + self.least_dither >= parent_bound {
+        if terminal_by_parent
+            && code_value(self.system.code(tile)) + self.least_dither >= parent_bound
+        {
             return;
         }
         // the region is built in place and lent (an `Option` of it would be
@@ -537,7 +546,11 @@ where
     fn dither(&self, code: f64, level: u32) -> f64 {
         // SplitMix64's finaliser (codes of dithered tiles lie below the
         // bound, far below 2^64)
-        let mut z = (code as u64 ^ (u64::from(level) << 58)).wrapping_add(self.seed);
+        // (the increment keeps code 0 of level 0 off the finaliser's fixed
+        // point 0, which would keep it at any density)
+        let mut z = (code as u64 ^ (u64::from(level) << 58))
+            .wrapping_add(self.seed)
+            .wrapping_add(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^= z >> 31;
@@ -547,7 +560,14 @@ where
     /// Places the sample of a terminal tile of code `code` and scaled bound
     /// `bound` (code units), if its code is kept (see the module doc).
     #[inline(always)]
-    fn emit(&self, tile: &S::Tile, level: u32, code: f64, bound: f64, out: &mut Vec<Sample<S::Point>>) {
+    fn emit(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        code: f64,
+        bound: f64,
+        out: &mut Vec<Sample<S::Point>>,
+    ) {
         // (the reciprocal keeps the division off the chain from the
         // density to the position)
         let per_tile = 1.0 / self.capacities[level as usize];

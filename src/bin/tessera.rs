@@ -5,11 +5,13 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use tessera::density::sphere::Cap;
+use tessera::density::plane::Shifted;
+use tessera::density::sphere::{Cap, Rotated};
 use tessera::density::{Density, Region};
 use tessera::engine::{Order, Sample};
 use tessera::io::points::SphereFormat;
-use tessera::tiling::sphere::SphereTiling;
+use tessera::tiling::plane::PlaneRegion;
+use tessera::tiling::sphere::{SphereRegion, SphereTiling};
 use tessera::tiling::TileSystem;
 use tessera::{engine, Error};
 
@@ -143,6 +145,11 @@ struct RequestArgs {
     /// Output file, `-` for standard output.
     #[arg(short, long, default_value = "-")]
     output: PathBuf,
+    /// Sample in a uniformly random frame drawn from this seed: a rotation
+    /// on the sphere, a toroidal shift on the plane. Estimates averaged
+    /// over seeds are unbiased; without it the output is deterministic.
+    #[arg(long)]
+    seed: Option<u64>,
 }
 
 impl RequestArgs {
@@ -182,7 +189,7 @@ struct SphereArgs {
     /// `LON,LAT,RADIUS_DEG`: only the tiles reaching it are visited, so a
     /// small window on a huge request costs what the window holds. The count
     /// is the expected one (exactness is a property of the whole set).
-    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with = "map")]
+    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with_all = ["map", "seed"])]
     within: Option<String>,
     /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
     /// luminance per unit solid angle, constant per pixel. Replaces --density.
@@ -199,11 +206,6 @@ struct SphereArgs {
     /// them, warn once and treat them as 0).
     #[arg(long, requires = "map")]
     strict: bool,
-    /// Sample in a uniformly random rotated frame drawn from this seed
-    /// (unbiased; average estimates over seeds). Without it the output is
-    /// deterministic.
-    #[arg(long, requires = "map")]
-    seed: Option<u64>,
     /// Print the set's separation, covering radius and mesh ratio (and a
     /// map's integral) to standard error.
     #[arg(long)]
@@ -264,7 +266,8 @@ struct PlaneArgs {
     invert: bool,
     #[command(flatten)]
     request: RequestArgs,
-    /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions).
+    /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions); csv:
+    /// `x,y,pdf` (pdf per unit area of the domain).
     #[arg(long, default_value = "txt")]
     format: String,
     /// Sample the rectangle `x0,y0,x1,y1` instead of the unit square (the
@@ -402,6 +405,9 @@ fn sphere(args: SphereArgs) -> Result<(), Error> {
     let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
+    if let Some(seed) = args.request.seed {
+        return sphere_rotated(&args, &Rotated::new(&*density, seed), format, pdf);
+    }
     let window = args.within.as_deref().map(Cap::window).transpose()?;
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(&tiling, args.request.count) {
@@ -467,7 +473,7 @@ fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<()
         path: path.into(),
         reason: e.to_string(),
     })?;
-    let map = match args.seed {
+    let map = match args.request.seed {
         Some(seed) => map.with_seed(seed),
         None => map,
     };
@@ -480,6 +486,37 @@ fn sphere_map(args: &SphereArgs, path: &Path, format: SphereFormat) -> Result<()
     }
     let mut out = create(&args.request.output)?;
     tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.request.output))
+}
+
+/// `sphere` with `--seed`: the density sampled in a random rotated frame.
+fn sphere_rotated(
+    args: &SphereArgs,
+    density: &Rotated<&(dyn Density<SphereRegion> + Send)>,
+    format: SphereFormat,
+    pdf: impl Fn(glam::DVec3) -> f64,
+) -> Result<(), Error> {
+    let tiling = SphereTiling::default();
+    let mut out = create(&args.request.output)?;
+    let written = match engine::stream(&tiling, args.request.count) {
+        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
+            let points = stream.map(|s| density.to_world(s.position));
+            tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        }
+        _ => {
+            let samples = args.request.generate(&tiling, density)?;
+            let points: Vec<glam::DVec3> = samples
+                .iter()
+                .map(|s| density.to_world(s.position))
+                .collect();
+            if args.report {
+                print_report(&points);
+            }
+            tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        }
+    };
+    written
         .and_then(|()| out.flush())
         .map_err(io_error(&args.request.output))
 }
@@ -525,26 +562,53 @@ where
         .map(tessera::density::rectangle::Rectangle::parse)
         .transpose()?;
     let count = args.request.count;
+    // the pdf per unit area of the domain: the density's unit square is
+    // stretched over the rectangle
+    let (lo, size) = rect.map_or((glam::DVec2::ZERO, glam::DVec2::ONE), |r| {
+        (r.lo, r.hi - r.lo)
+    });
+    let pdf = |q: glam::DVec2| density.value((q - lo) / size) / (density.mean() * size.x * size.y);
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(tiling, count) {
         // large uniform requests stream: memory stays O(depth)
-        Some(stream) if density.constant().is_some() && rect.is_none() && count > STREAM_ABOVE => {
-            tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format)
+        Some(stream)
+            if density.constant().is_some()
+                && rect.is_none()
+                && args.request.seed.is_none()
+                && count > STREAM_ABOVE =>
+        {
+            tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format, pdf)
         }
         _ => {
-            let points: Vec<glam::DVec2> = match rect {
-                Some(rect) => (args.request.generate(tiling, &rect.restrict(&*density)))?
-                    .iter()
-                    .map(|s| rect.to_world(s.position))
-                    .collect(),
+            let restricted = rect.map(|rect| rect.restrict(&*density));
+            let square: &(dyn Density<PlaneRegion> + Sync) = match &restricted {
+                Some(r) => r,
+                None => &*density,
+            };
+            let in_square: Vec<glam::DVec2> = match args.request.seed {
+                Some(seed) => {
+                    let shifted = Shifted::new(square, seed);
+                    let samples = args.request.generate(tiling, &shifted)?;
+                    samples
+                        .iter()
+                        .map(|s| shifted.to_world(s.position))
+                        .collect()
+                }
                 None => args
                     .request
-                    .generate(tiling, &*density)?
+                    .generate(tiling, square)?
                     .iter()
                     .map(|s| s.position)
                     .collect(),
             };
-            tessera::io::points::write_plane(&mut out, points, format)
+            let points: Vec<glam::DVec2> = match rect {
+                Some(rect) => in_square
+                    .into_iter()
+                    .map(|p: glam::DVec2| rect.to_world(p))
+                    .collect(),
+                None => in_square,
+            };
+            tessera::io::points::write_plane(&mut out, points, format, pdf)
         }
     };
     written

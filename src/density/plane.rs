@@ -293,3 +293,107 @@ pub fn parse(spec: &str, invert: bool) -> Result<Box<dyn Density<PlaneRegion> + 
         _ => fail("unknown planar density; expected 'uniform', 'ramp' or 'image:PATH'"),
     }
 }
+
+/// A planar density sampled under a uniformly random toroidal shift: the
+/// engine samples `value(p) = inner((p + shift) mod 1)`, and
+/// [`Shifted::to_world`] maps its samples back. Averaged over seeds,
+/// estimates from the samples are unbiased (see [`crate::engine`]).
+///
+/// # Example
+/// ```
+/// use tessera::density::plane::{Ramp, Shifted};
+/// use tessera::{engine, tiling::plane::PlaneTiling};
+/// let ramp = Shifted::new(Ramp, 5);
+/// let s = engine::generate(&PlaneTiling::ppentomino(), &ramp, 2000, true).unwrap();
+/// let right = s.iter().filter(|s| ramp.to_world(s.position).x >= 0.5).count();
+/// assert!(right > 1400);
+/// ```
+pub struct Shifted<D> {
+    inner: D,
+    shift: DVec2,
+    seed: u64,
+}
+
+impl<D> Shifted<D> {
+    /// `inner` shifted by two numbers of [`crate::baselines::SplitMix64`]`(seed)`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{plane::Shifted, Uniform};
+    /// let p = Shifted::new(Uniform, 1).to_world(glam::DVec2::new(0.5, 0.5));
+    /// assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
+    /// ```
+    pub fn new(inner: D, seed: u64) -> Self {
+        let mut rng = crate::baselines::SplitMix64::new(seed);
+        let shift = DVec2::new(rng.next_f64(), rng.next_f64());
+        Shifted { inner, shift, seed }
+    }
+
+    /// The point of the unit square a sample of the shifted frame stands for.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{plane::Shifted, Uniform};
+    /// let s = Shifted::new(Uniform, 2);
+    /// assert_ne!(s.to_world(glam::DVec2::ZERO), glam::DVec2::ZERO);
+    /// ```
+    pub fn to_world(&self, p: DVec2) -> DVec2 {
+        wrap_unit(p + self.shift)
+    }
+}
+
+/// `p` reduced into `[0, 1)^2`.
+fn wrap_unit(p: DVec2) -> DVec2 {
+    let f = |v: f64| {
+        let w = v - v.floor();
+        if w >= 1.0 {
+            0.0
+        } else {
+            w
+        }
+    };
+    DVec2::new(f(p.x), f(p.y))
+}
+
+impl<D: Density<PlaneRegion>> Density<PlaneRegion> for Shifted<D> {
+    fn bound(&self, region: &PlaneRegion) -> f64 {
+        // the part of the box inside the square, shifted: it crosses the
+        // square's far edges at most once per axis, so at most four pieces
+        let lo = region.lo.clamp(DVec2::ZERO, DVec2::ONE) + self.shift;
+        let hi = region.hi.clamp(DVec2::ZERO, DVec2::ONE) + self.shift;
+        let spans = |a: f64, b: f64| -> [Option<(f64, f64)>; 2] {
+            [
+                (a < 1.0).then(|| (a, b.min(1.0))),
+                (b > 1.0).then(|| (a.max(1.0) - 1.0, b - 1.0)),
+            ]
+        };
+        let mut bound: f64 = 0.0;
+        for (x0, x1) in spans(lo.x, hi.x).into_iter().flatten() {
+            for (y0, y1) in spans(lo.y, hi.y).into_iter().flatten() {
+                let piece = PlaneRegion {
+                    lo: DVec2::new(x0, y0),
+                    hi: DVec2::new(x1, y1),
+                    ..*region
+                };
+                bound = bound.max(self.inner.bound(&piece));
+            }
+        }
+        bound
+    }
+    fn average(&self, region: &PlaneRegion) -> f64 {
+        let cells = region.centres();
+        cells.iter().map(|&p| self.value(p)).sum::<f64>() / cells.len().max(1) as f64
+    }
+    fn value(&self, point: DVec2) -> f64 {
+        self.inner.value(wrap_unit(point + self.shift))
+    }
+    fn mean(&self) -> f64 {
+        self.inner.mean()
+    }
+    fn constant(&self) -> Option<f64> {
+        self.inner.constant()
+    }
+    fn seed(&self) -> Option<u64> {
+        Some(self.seed)
+    }
+}

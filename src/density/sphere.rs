@@ -348,3 +348,91 @@ pub(crate) fn cell_centre_mean(nside: u32, f: impl Fn(DVec3) -> f64) -> f64 {
     }
     sum / (12.0 * side * side)
 }
+
+/// A sphere density sampled in a uniformly random rotated frame: the
+/// engine samples `value(p) = inner(rotation p)`, and
+/// [`Rotated::to_world`] maps its samples back. Averaged over seeds,
+/// estimates from the samples are unbiased (see [`crate::engine`]).
+///
+/// It bounds the inner density over each tile's bounding cap (centre and
+/// radius), which is all that [`Cap`], [`SphereFn`] and
+/// [`super::region::Regions`] read of a tile; an environment map rotates
+/// itself ([`super::envmap::EnvMap::with_seed`]).
+///
+/// # Example
+/// ```
+/// use tessera::density::{sphere::{Cap, Rotated}, Density};
+/// use tessera::{engine, tiling::sphere::SphereTiling};
+/// let cap = Rotated::new(Cap::new(0.0, 90.0, 20.0, 50.0).unwrap(), 7);
+/// let s = engine::generate(&SphereTiling::default(), &cap, 500, true).unwrap();
+/// let north = s.iter().filter(|s| cap.to_world(s.position).z > 0.94).count();
+/// assert!(north > 300);
+/// ```
+pub struct Rotated<D> {
+    inner: D,
+    rotation: glam::DMat3,
+    seed: u64,
+}
+
+impl<D> Rotated<D> {
+    /// `inner` in the frame of [`crate::baselines::random_rotation`]`(seed)`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{sphere::Rotated, Uniform};
+    /// let r = Rotated::new(Uniform, 3);
+    /// assert!((r.to_world(glam::DVec3::Z).length() - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn new(inner: D, seed: u64) -> Self {
+        Rotated {
+            inner,
+            rotation: crate::baselines::random_rotation(seed),
+            seed,
+        }
+    }
+
+    /// The world direction of a sample of the rotated frame.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{sphere::Rotated, Uniform};
+    /// let r = Rotated::new(Uniform, 3);
+    /// assert_ne!(r.to_world(glam::DVec3::Z), glam::DVec3::Z);
+    /// ```
+    pub fn to_world(&self, p: DVec3) -> DVec3 {
+        self.rotation * p
+    }
+
+    /// The tile's bounding cap, rotated into the world.
+    fn cap_of(&self, region: &SphereRegion) -> SphereRegion {
+        let centre = crate::healpix::FacePoint::from_vec(self.rotation * region.center());
+        SphereRegion {
+            centroid: centre,
+            radius: region.radius,
+            face: centre.face,
+            cells: [[centre.x, centre.y]; 5],
+        }
+    }
+}
+
+impl<D: Density<SphereRegion>> Density<SphereRegion> for Rotated<D> {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        self.inner.bound(&self.cap_of(region))
+    }
+    fn average(&self, region: &SphereRegion) -> f64 {
+        let probes = region.probes();
+        probes.iter().map(|&p| self.value(p)).sum::<f64>() / probes.len() as f64
+    }
+    fn value(&self, point: DVec3) -> f64 {
+        self.inner.value(self.rotation * point)
+    }
+    fn mean(&self) -> f64 {
+        self.inner.mean()
+    }
+    fn constant(&self) -> Option<f64> {
+        self.inner.constant()
+    }
+    fn seed(&self) -> Option<u64> {
+        Some(self.seed)
+    }
+}

@@ -312,6 +312,8 @@ pub enum PlaneFormat {
     Txt,
     /// UTK binary, 2 dimensions.
     Bin,
+    /// `x,y,pdf` with a header line: the pdf per unit area of the domain.
+    Csv,
 }
 
 impl std::str::FromStr for PlaneFormat {
@@ -320,23 +322,30 @@ impl std::str::FromStr for PlaneFormat {
         match s {
             "txt" => Ok(PlaneFormat::Txt),
             "bin" => Ok(PlaneFormat::Bin),
+            "csv" => Ok(PlaneFormat::Csv),
             other => Err(Error::Request(format!(
-                "unknown planar format '{other}'; expected txt or bin"
+                "unknown planar format '{other}'; expected txt, bin or csv"
             ))),
         }
     }
 }
 
-/// Writes planar points in the given format.
+/// Writes planar points in the given format; `pdf` is asked only for the
+/// formats that carry it.
 ///
 /// # Example
 /// ```
 /// use tessera::io::points::{write_plane, PlaneFormat};
 /// let mut out = Vec::new();
-/// write_plane(&mut out, [glam::DVec2::new(0.5, 0.25)], PlaneFormat::Txt).unwrap();
-/// assert_eq!(String::from_utf8(out).unwrap(), "0.5 0.25\n");
+/// write_plane(&mut out, [glam::DVec2::new(0.5, 0.25)], PlaneFormat::Csv, |_| 1.0).unwrap();
+/// assert_eq!(String::from_utf8(out).unwrap(), "x,y,pdf\n0.5,0.25,1\n");
 /// ```
-pub fn write_plane<I>(out: &mut impl Write, points: I, format: PlaneFormat) -> std::io::Result<()>
+pub fn write_plane<I>(
+    out: &mut impl Write,
+    points: I,
+    format: PlaneFormat,
+    pdf: impl Fn(glam::DVec2) -> f64,
+) -> std::io::Result<()>
 where
     I: IntoIterator<Item = glam::DVec2>,
     I::IntoIter: ExactSizeIterator,
@@ -346,6 +355,12 @@ where
         PlaneFormat::Txt => {
             for p in points {
                 writeln!(out, "{} {}", p.x, p.y)?;
+            }
+        }
+        PlaneFormat::Csv => {
+            writeln!(out, "x,y,pdf")?;
+            for p in points {
+                writeln!(out, "{},{},{}", p.x, p.y, pdf(p))?;
             }
         }
         PlaneFormat::Bin => {
