@@ -138,6 +138,14 @@ fn every_map_is_finite_nonnegative_deterministic_and_seeded() {
         }
         assert!(sky.generate(0, 4, 1).rgb.is_empty());
     }
+    for sigma in [f64::NAN, f64::INFINITY, 40.0, -3.0] {
+        let m = Sky::Textured { sigma }.generate(64, 32, 1);
+        assert!(
+            m.rgb.iter().flatten().all(|c| c.is_finite() && *c >= 0.0),
+            "{sigma}"
+        );
+        assert_eq!(Sky::Textured { sigma }.name(), "textured");
+    }
     assert_eq!(Sky::Smooth.generate(W, H, 1), Sky::Smooth.generate(W, H, 2));
 }
 
@@ -486,6 +494,7 @@ fn exr_round_trips_f32_exactly_and_f16_dwab_closely() {
         );
         assert!(worst_bright < 0.06, "{}: {worst_bright}", sky.name());
         assert!(energy.abs() < 0.02, "{}: {energy}", sky.name());
+        assert!(median_error < 0.05, "{}: {median_error}", sky.name());
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -499,6 +508,16 @@ fn exr_write_errors_name_the_path() {
         let err = map.write_exr(&path, half).unwrap_err().to_string();
         assert!(err.contains("missing-folder"), "{err}");
     }
+    let empty = SynthMap {
+        width: 0,
+        height: 0,
+        rgb: vec![],
+    };
+    let err = empty
+        .write_exr(&dir.join("empty.exr"), false)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("empty.exr"), "{err}");
     let broken = SynthMap {
         width: 4,
         height: 4,

@@ -38,8 +38,8 @@ pub enum Sky {
     Overcast,
     /// City at night: a dark sky with skyglow toward the horizon over dark
     /// textured ground, 300-600 lights of 1-4 pixels at 1e2-1e3 times the
-    /// background (0.01) mostly just below the horizon, 6-10 street lamps
-    /// near 1e4 times it; 12 % zero pixels (dark areas compress worst), zero
+    /// background level 0.01 (the map's median is about 0.004), mostly just
+    /// below the horizon, 6-10 street lamps near 1e4 times it; 12 % zero pixels (dark areas compress worst), zero
     /// lines beside the street lamps.
     CityNight,
     /// A dim room seen from inside: 2-4 rectangular ceiling lamps, 1-2
@@ -52,7 +52,9 @@ pub enum Sky {
     /// at every scale down to pixels; 3 % zero pixels, zero lines beside
     /// the two brightest spots.
     Textured {
-        /// Standard deviation of the log radiance.
+        /// Standard deviation of the log radiance (a non-finite one is
+        /// taken as 0; the exponent is clamped to +-80 so values stay
+        /// finite in f32).
         sigma: f64,
     },
     /// Issue 17's first reproduction: a smooth sky gradient over a darker
@@ -65,7 +67,8 @@ pub enum Sky {
     /// its pixels exactly 0, as clamped compression noise leaves them.
     Zeros20,
     /// The reference without texture or zeros: the smooth sky gradient
-    /// over a constant ground of 0.1, where issue 17 saw no bias.
+    /// over a constant ground of 0.1, where issue 17 saw no bias (the same
+    /// for every seed).
     Smooth,
 }
 
@@ -112,9 +115,9 @@ impl Sky {
             Sky::Overcast => "overcast",
             Sky::CityNight => "city-night",
             Sky::Interior => "interior",
-            Sky::Textured { sigma } if sigma == 0.5 => "textured-0.5",
-            Sky::Textured { sigma } if sigma == 1.0 => "textured-1",
-            Sky::Textured { sigma } if sigma == 2.0 => "textured-2",
+            Sky::Textured { sigma: 0.5 } => "textured-0.5",
+            Sky::Textured { sigma: 1.0 } => "textured-1",
+            Sky::Textured { sigma: 2.0 } => "textured-2",
             Sky::Textured { .. } => "textured",
             Sky::GroundLognormal => "ground-lognormal",
             Sky::GroundLognormalMild => "ground-lognormal-mild",
@@ -652,13 +655,14 @@ fn interior(map: &mut SynthMap, rng: &mut SplitMix64) {
 
 fn textured(map: &mut SynthMap, sigma: f64, rng: &mut SplitMix64) {
     let (w, h) = (map.width, map.height);
+    let sigma = if sigma.is_finite() { sigma } else { 0.0 };
     let f = fbm(w, h, (2, 4), 0.6, rng);
     let sky_tint = tint([0.7, 0.85, 1.1]);
     let ground_tint = tint([0.85, 0.8, 0.7]);
     map.rgb = (0..w * h)
         .map(|k| {
             let cos_t = row_theta(k / w, h).cos();
-            let t = (sigma * f[k]).exp();
+            let t = (sigma * f[k]).clamp(-80.0, 80.0).exp();
             if cos_t > 0.0 {
                 paint((0.8 + 0.2 * cos_t) * t, sky_tint)
             } else {
