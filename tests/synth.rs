@@ -150,6 +150,19 @@ fn every_map_is_finite_nonnegative_deterministic_and_seeded() {
 }
 
 #[test]
+fn every_map_is_an_environment_map_density() {
+    use tessera::density::envmap::{EnvMap, Up};
+    for sky in Sky::all() {
+        let map = EnvMap::new(sky.generate(256, 128, 1).raster(), Up::Z).unwrap();
+        assert!(
+            map.integral() > 0.0 && map.integral().is_finite(),
+            "{}",
+            sky.name()
+        );
+    }
+}
+
+#[test]
 fn clear_sky_has_a_bright_antialiased_sun_with_an_aureole_and_horizon_glow() {
     for seed in 1..=4 {
         let map = Sky::ClearSky.generate(W, H, seed);
