@@ -25,6 +25,7 @@ mod memory;
 pub mod metrics;
 pub mod optimize;
 mod sampler;
+pub mod synth;
 pub mod tiling;
 
 pub use engine::Sample;
