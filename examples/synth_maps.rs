@@ -7,7 +7,11 @@ use std::path::PathBuf;
 use tessera::synth::{Sky, SynthMap};
 
 fn main() -> Result<(), tessera::Error> {
-    let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "synth-maps".into()));
+    let dir = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| "synth-maps".into()),
+    );
     std::fs::create_dir_all(&dir).map_err(|source| tessera::Error::Io {
         path: dir.clone(),
         source,
