@@ -23,7 +23,8 @@ fn xyz_lonlat_and_csv_formats() {
         assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-12);
     }
     let lonlat = stdout(&["sphere", "-n", "50", "--format", "lonlat"]);
-    for line in lonlat.lines() {
+    assert_eq!(lonlat.lines().next(), Some("# lon lat (degrees)"));
+    for line in lonlat.lines().skip(1) {
         let v: Vec<f64> = line.split(' ').map(|s| s.parse().unwrap()).collect();
         assert!((-180.0..180.0).contains(&v[0]) && (-90.0..=90.0).contains(&v[1]));
     }
@@ -125,6 +126,7 @@ fn a_window_writes_only_what_falls_in_it() {
     let text = stdout(&args);
     let lats: Vec<f64> = text
         .lines()
+        .skip(1)
         .map(|l| l.split(' ').nth(1).unwrap().parse().unwrap())
         .collect();
     assert!((2100..2400).contains(&lats.len()), "{}", lats.len());
@@ -275,5 +277,79 @@ fn plot_and_metrics_png() {
         "north",
     ]);
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--toward 'north'"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn point_files_are_refused_with_the_reason_or_read_whatever_tessera_wrote() {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).display().to_string();
+    std::fs::write(path("garbage.txt"), "hello world\n").unwrap();
+    std::fs::write(path("empty.txt"), "").unwrap();
+    let write = |args: &[&str], name: &str| {
+        let mut all: Vec<&str> = args.to_vec();
+        let out = path(name);
+        all.extend(["-n", "200", "-o", &out]);
+        assert!(tessera(&all).status.success());
+    };
+    write(&["sphere", "--format", "xyz"], "s.xyz");
+    write(&["sphere", "--format", "lonlat"], "s.lonlat");
+    write(&["sphere", "--format", "csv"], "s.csv");
+    write(&["sphere", "--format", "bin"], "s.bin");
+    write(&["sphere", "--format", "geojson"], "s.geojson");
+    write(&["plane", "--system", "ppentomino"], "p.txt");
+    write(
+        &["plane", "--system", "ppentomino", "--format", "csv"],
+        "p.csv",
+    );
+    write(
+        &["plane", "--system", "ppentomino", "--format", "bin"],
+        "p.bin",
+    );
+    // (file, what metrics sphere says, what metrics plane says): None reads
+    let cases = [
+        (
+            "garbage.txt",
+            Some("not a list of numbers"),
+            Some("not a list of numbers"),
+        ),
+        (
+            "empty.txt",
+            Some("holds no points"),
+            Some("holds no points"),
+        ),
+        ("s.xyz", None, Some("sphere points")),
+        ("s.lonlat", None, Some("sphere points")),
+        ("s.csv", None, Some("sphere points")),
+        ("s.bin", None, Some("3-dimensional")),
+        ("s.geojson", None, Some("sphere points")),
+        ("p.txt", Some("plane points"), None),
+        ("p.csv", Some("x,y,z"), None),
+        ("p.bin", Some("2-dimensional"), None),
+    ];
+    for (file, sphere, plane) in cases {
+        for (kind, expected) in [("sphere", sphere), ("plane", plane)] {
+            let out = tessera(&["metrics", kind, &path(file), "--json"]);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            match expected {
+                None => assert!(out.status.success(), "{kind} {file}: {stderr}"),
+                Some(reason) => {
+                    assert_eq!(out.status.code(), Some(1), "{kind} {file}");
+                    assert!(
+                        stderr.contains(file) && stderr.contains(reason),
+                        "{kind} {file}: {stderr}"
+                    );
+                }
+            }
+        }
+    }
+    // a lon/lat round trip draws too
+    let png = path("s.png");
+    assert!(
+        tessera(&["plot", "sphere", &path("s.lonlat"), "--png", &png])
+            .status
+            .success()
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -7,7 +7,7 @@
 
 use crate::Error;
 use glam::DVec3;
-use std::io::{BufRead, Read, Write};
+use std::io::{Read, Write};
 use std::path::Path;
 
 /// Magic number opening a UTK binary point file.
@@ -73,14 +73,15 @@ pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std
 }
 
 /// Writes sphere points in the given format; `pdf` is asked only for CSV
-/// and GeoJSON.
+/// and GeoJSON. A `lonlat` file starts with a `# lon lat (degrees)` line,
+/// which tells readers it from a planar `x y` file.
 ///
 /// # Example
 /// ```
 /// use tessera::io::points::{write_sphere, SphereFormat};
 /// let mut out = Vec::new();
 /// write_sphere(&mut out, [glam::DVec3::Z], SphereFormat::LonLat, |_| 0.0).unwrap();
-/// assert_eq!(String::from_utf8(out).unwrap(), "0 90\n");
+/// assert_eq!(String::from_utf8(out).unwrap(), "# lon lat (degrees)\n0 90\n");
 /// ```
 pub fn write_sphere<I>(
     out: &mut impl Write,
@@ -100,6 +101,8 @@ where
             }
         }
         SphereFormat::LonLat => {
+            // the header tells a lon/lat file from a planar `x y` one
+            writeln!(out, "{LONLAT_HEADER}")?;
             for p in points {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
                 writeln!(out, "{lon} {lat}")?;
@@ -196,8 +199,13 @@ fn read_geojson(bytes: &[u8]) -> Result<Vec<Vec<f64>>, String> {
 
 /// Reads a point set written by tessera: UTK binary (detected by its magic)
 /// GeoJSON Points (detected by a leading `{`; sphere points only), or text
-/// with `dims` numbers per line (blank lines and `#` comments
-/// skipped; a CSV header line is skipped and commas separate values).
+/// with `dims` numbers per line (blank lines and `#` comments skipped,
+/// commas or blanks between values; a CSV header names the `x`, `y`
+/// (and `z`) columns; sphere points may be `lon lat` lines after the
+/// header line `tessera sphere --format lonlat` writes). Refuses a file
+/// it cannot read, one that holds no points, plane points read as sphere
+/// points (not unit vectors) and the reverse (too many values), naming
+/// the line.
 ///
 /// # Example
 /// ```
@@ -237,47 +245,163 @@ pub fn read_points_from(
                 body.len()
             )));
         }
-        return Ok(body
+        let points: Vec<Vec<f64>> = body
             .chunks_exact(dims * 8)
             .map(|p| {
                 p.chunks_exact(8)
                     .map(|b| f64::from_le_bytes(b.try_into().expect("8-byte chunk")))
                     .collect()
             })
-            .collect());
+            .collect();
+        check_points(&points, dims).map_err(fail)?;
+        return Ok(points);
     }
     if bytes.trim_ascii_start().starts_with(b"{") {
         if dims != 3 {
             return Err(fail("GeoJSON holds sphere points, not plane points".into()));
         }
-        return read_geojson(&bytes).map_err(fail);
+        let points = read_geojson(&bytes).map_err(fail)?;
+        check_points(&points, dims).map_err(fail)?;
+        return Ok(points);
     }
+    let points = read_text(&bytes, dims).map_err(fail)?;
+    check_points(&points, dims).map_err(fail)?;
+    Ok(points)
+}
+
+/// The first line of a `lonlat` file.
+const LONLAT_HEADER: &str = "# lon lat (degrees)";
+
+/// Text points: `dims` numbers a line, or for the sphere `lon lat` lines
+/// after [`LONLAT_HEADER`]; a CSV header names its columns (`x,y[,z],...`).
+fn read_text(bytes: &[u8], dims: usize) -> Result<Vec<Vec<f64>>, String> {
+    let text =
+        std::str::from_utf8(bytes).map_err(|_| "is not text, UTK binary or GeoJSON".to_string())?;
     let mut points = Vec::new();
-    for (number, line) in bytes.lines().enumerate() {
-        let line = line.map_err(|e| fail(format!("line {}: {e}", number + 1)))?;
+    let mut lonlat = false;
+    // the columns holding the coordinates (from a CSV header)
+    let mut columns: Option<Vec<usize>> = None;
+    let mut width: Option<usize> = None;
+    for (number, line) in text.lines().enumerate() {
         let line = line.trim();
+        if line == LONLAT_HEADER && points.is_empty() {
+            if dims != 3 {
+                return Err("is a lon/lat file of sphere points, not plane points".into());
+            }
+            lonlat = true;
+            continue;
+        }
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let values: Result<Vec<f64>, _> = line
+        let fields: Vec<&str> = line
             .split(|c: char| c == ',' || c.is_whitespace())
             .filter(|s| !s.is_empty())
-            .map(str::parse::<f64>)
             .collect();
-        match values {
-            Ok(v) if v.len() >= dims => points.push(v[..dims].to_vec()),
-            Ok(v) => {
-                return Err(fail(format!(
-                    "line {}: {} values, expected {dims}",
-                    number + 1,
-                    v.len()
-                )))
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        let Ok(values) = values else {
+            if points.is_empty() && columns.is_none() && width.is_none() && line.contains(',') {
+                columns = Some(csv_columns(&fields, dims)?);
+                continue;
             }
-            Err(_) if points.is_empty() && number == 0 => continue, // CSV header
-            Err(_) => return Err(fail(format!("line {}: not a list of numbers", number + 1))),
+            return Err(format!("line {}: not a list of numbers", number + 1));
+        };
+        let wanted = if lonlat { 2 } else { dims };
+        let count = values.len();
+        if *width.get_or_insert(count) != count {
+            return Err(format!(
+                "line {}: {count} values, where the lines above hold {}",
+                number + 1,
+                width.unwrap_or(0)
+            ));
+        }
+        let row: Vec<f64> = match &columns {
+            Some(cols) if cols.iter().all(|&c| c < values.len()) => {
+                cols.iter().map(|&c| values[c]).collect()
+            }
+            Some(_) => {
+                return Err(format!(
+                    "line {}: fewer values than the header's columns",
+                    number + 1
+                ))
+            }
+            None if values.len() == wanted => values,
+            None => {
+                let hint = match (dims, values.len()) {
+                    (2, 3) => " (is it a file of sphere points?)",
+                    (3, 2) => " (a lon/lat file starts with the line '# lon lat (degrees)'; is it a file of plane points?)",
+                    _ => "",
+                };
+                return Err(format!(
+                    "line {}: {} values, expected {wanted}{hint}",
+                    number + 1,
+                    values.len()
+                ));
+            }
+        };
+        if lonlat {
+            let (lon, lat) = (row[0], row[1]);
+            if !(lon.is_finite() && lat.abs() <= 90.0) {
+                return Err(format!(
+                    "line {}: ({lon}, {lat}) is not a longitude and latitude in degrees",
+                    number + 1
+                ));
+            }
+            let v = crate::density::sphere::lonlat_to_vec(lon, lat);
+            points.push(vec![v.x, v.y, v.z]);
+        } else {
+            points.push(row);
         }
     }
     Ok(points)
+}
+
+/// The coordinate columns a CSV header names: `x`, `y` and, for the
+/// sphere, `z`.
+fn csv_columns(names: &[&str], dims: usize) -> Result<Vec<usize>, String> {
+    let find = |name: &str| names.iter().position(|n| n.eq_ignore_ascii_case(name));
+    let wanted: &[&str] = if dims == 3 {
+        &["x", "y", "z"]
+    } else {
+        &["x", "y"]
+    };
+    let columns: Option<Vec<usize>> = wanted.iter().map(|n| find(n)).collect();
+    match columns {
+        Some(c) => {
+            if dims == 2 && find("z").is_some() {
+                return Err(
+                    "its CSV header has a z column: a file of sphere points, not plane points"
+                        .into(),
+                );
+            }
+            Ok(c)
+        }
+        None => Err(format!(
+            "its CSV header '{}' does not name the columns {}",
+            names.join(","),
+            wanted.join(",")
+        )),
+    }
+}
+
+/// Refuses an empty set, and sphere points off the unit sphere (a planar
+/// file read as a sphere one).
+fn check_points(points: &[Vec<f64>], dims: usize) -> Result<(), String> {
+    if points.is_empty() {
+        return Err("holds no points".into());
+    }
+    for (k, p) in points.iter().enumerate() {
+        if p.iter().any(|v| !v.is_finite()) {
+            return Err(format!("point {}: {p:?} is not finite", k + 1));
+        }
+        if dims == 3 {
+            let norm = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            if (norm - 1.0).abs() > 1e-6 {
+                return Err(format!("point {}: {p:?} is not a unit vector (length {norm}); is it a file of plane points?", k + 1));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Reads a point file from disk (see [`read_points_from`]).
