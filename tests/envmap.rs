@@ -436,13 +436,48 @@ fn hostile_files_give_errors_naming_them() {
         exr::prelude::Compression::Uncompressed,
     );
     assert!(message(&nan, &opts).contains("nothing to sample"));
-    // --strict refuses the hostile map, naming the count
+    // --strict refuses the hostile map (its NaN), naming the pixel
     let strict = ReadOptions {
         strict: true,
         ..Default::default()
     };
     let e = message(&good, &strict);
-    assert!(e.contains("pixel(s) are negative, NaN or infinite"), "{e}");
+    assert!(e.contains("is NaN") && e.contains("column"), "{e}");
+}
+
+/// `--strict` passes the negative pixels a lossy codec leaves (the
+/// generated maps written as f16 DWAB) and refuses a negative pixel deeper
+/// than that noise.
+#[test]
+fn strict_passes_codec_noise_and_refuses_damage() {
+    let dir = temp_dir("strict");
+    let strict = ReadOptions {
+        strict: true,
+        ..Default::default()
+    };
+    let mut noisy = 0;
+    for sky in tessera::synth::Sky::all() {
+        let path = dir.join(format!("{}.exr", sky.name()));
+        sky.generate(512, 256, 1).write_exr(&path, true).unwrap();
+        let lenient = tessera::io::image::read_raster(&path, &ReadOptions::default()).unwrap();
+        noisy += usize::from(lenient.bad_pixels > 0);
+        let read = tessera::io::image::read_raster(&path, &strict);
+        assert!(read.is_ok(), "{}: {:?}", sky.name(), read.err());
+    }
+    assert!(noisy >= 5, "the codec left negatives in only {noisy} maps");
+    // a dark pixel far from bright ones, at half the median: damage
+    let mut map = tessera::synth::Sky::Overcast.generate(64, 32, 1);
+    map.rgb[20 * 64 + 10] = [-0.5, -0.5, -0.5];
+    let path = dir.join("damaged.exr");
+    map.write_exr(&path, false).unwrap();
+    let e = tessera::io::image::read_raster(&path, &strict)
+        .err()
+        .expect("damage is refused")
+        .to_string();
+    assert!(
+        e.contains("column 10, row 20") && e.contains("beyond codec noise"),
+        "{e}"
+    );
 }
 
 #[test]

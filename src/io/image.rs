@@ -37,7 +37,9 @@ pub const MAX_PIXELS: usize = 1 << 28;
 pub struct ReadOptions {
     /// Use this channel (e.g. `R`, `Y`, `diffuse.G`) instead of luminance.
     pub channel: Option<String>,
-    /// Refuse negative, NaN and infinite pixels instead of zeroing them.
+    /// Refuse NaN and infinite pixels, and negative ones beyond the noise
+    /// a lossy codec leaves ([`Raster::from_values`]), instead of zeroing
+    /// them.
     pub strict: bool,
     /// Undo the sRGB transfer curve of 8- and 16-bit PNGs (they store
     /// display values; importance should be linear). EXR and `.hdr` are
@@ -87,9 +89,17 @@ impl Raster {
     }
 
     /// Builds a raster from raw importance values (row-major, `width *
-    /// height` of them), zeroing and counting bad ones; `strict` refuses
-    /// them, and a raster with nothing positive is refused. `name` is what
+    /// height` of them), zeroing and counting bad ones (negative, NaN or
+    /// infinite); a raster with nothing positive is refused. `name` is what
     /// errors call the data.
+    ///
+    /// `strict` refuses NaN and infinite pixels, and negative ones deeper
+    /// than codec noise: a lossy codec (OpenEXR's DWAA/DWAB, PIZ on f16)
+    /// rings around bright pixels and dithers dark areas around zero, so a
+    /// negative pixel passes when its magnitude is at most
+    /// [`Raster::NOISE_NEIGHBOURHOOD`] of the brightest pixel within two
+    /// pixels of it, or [`Raster::NOISE_MEDIAN`] of the median positive
+    /// pixel. Passing pixels are zeroed and counted like the others.
     ///
     /// # Example
     /// ```
@@ -119,22 +129,26 @@ impl Raster {
                 values.len()
             )));
         }
+        if strict {
+            if let Some((k, v)) = damaged(&values, width) {
+                let (i, j) = (k % width, k / width);
+                return Err(fail(format!(
+                    "pixel at column {i}, row {j} is {v}: NaN, infinite, or negative beyond codec noise \
+                     ({} of the brightest pixel within two pixels, {} of the median positive one)",
+                    Self::NOISE_NEIGHBOURHOOD,
+                    Self::NOISE_MEDIAN
+                )));
+            }
+        }
         let mut values = values;
         let mut bad_pixels = 0;
-        let mut first_bad = None;
         let mut any_positive = false;
-        for (k, v) in values.iter_mut().enumerate() {
+        for v in values.iter_mut() {
             if !(v.is_finite() && *v >= 0.0) {
                 bad_pixels += 1;
-                first_bad.get_or_insert((k % width, k / width, *v));
                 *v = 0.0;
             }
             any_positive |= *v > 0.0;
-        }
-        if let (true, Some((i, j, v))) = (strict, first_bad) {
-            return Err(fail(format!(
-                "{bad_pixels} pixel(s) are negative, NaN or infinite (first: column {i}, row {j}, value {v})"
-            )));
         }
         if !any_positive {
             return Err(fail(
@@ -148,6 +162,44 @@ impl Raster {
             bad_pixels,
         })
     }
+}
+
+impl Raster {
+    /// A negative pixel within this fraction of the brightest pixel two
+    /// pixels around it is codec ringing ([`Raster::from_values`]).
+    pub const NOISE_NEIGHBOURHOOD: f64 = 0.05;
+    /// A negative pixel within this fraction of the median positive pixel
+    /// is codec noise around zero ([`Raster::from_values`]).
+    pub const NOISE_MEDIAN: f64 = 0.01;
+}
+
+/// The first pixel `strict` refuses (see [`Raster::from_values`]), with its
+/// value.
+fn damaged(values: &[f64], width: usize) -> Option<(usize, f64)> {
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Some((k, values[k]));
+    }
+    let mut positive: Vec<f64> = values.iter().copied().filter(|&v| v > 0.0).collect();
+    let median = if positive.is_empty() {
+        0.0
+    } else {
+        let mid = positive.len() / 2;
+        *positive.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    let height = values.len() / width;
+    values.iter().enumerate().find_map(|(k, &v)| {
+        if v >= 0.0 || -v <= Raster::NOISE_MEDIAN * median {
+            return None;
+        }
+        let (i, j) = (k % width, k / width);
+        let mut brightest: f64 = 0.0;
+        for jj in j.saturating_sub(2)..(j + 3).min(height) {
+            for ii in i.saturating_sub(2)..(i + 3).min(width) {
+                brightest = brightest.max(values[jj * width + ii]);
+            }
+        }
+        (-v > Raster::NOISE_NEIGHBOURHOOD * brightest).then_some((k, v))
+    })
 }
 
 /// A named channel of decoded samples.
