@@ -151,12 +151,12 @@ impl Bench<'_> {
     /// `errors` against the library's estimator, on a few normals.
     fn check(&self, samples: &[DVec3]) {
         let fast = self.errors(samples);
-        for k in 0..4 {
-            let e = estimate(self.map, samples, self.normals[k]) / self.reference[k] - 1.0;
+        let normals = self.normals.iter().zip(&self.reference).zip(fast);
+        for ((&n, r), f) in normals.take(4) {
+            let e = estimate(self.map, samples, n) / r - 1.0;
             assert!(
-                (e - fast[k]).abs() <= 1e-9 * (1.0 + e.abs()),
-                "estimator mismatch {e} {}",
-                fast[k]
+                (e - f).abs() <= 1e-9 * (1.0 + e.abs()),
+                "estimator mismatch {e} {f}"
             );
         }
     }
@@ -231,8 +231,7 @@ fn reference_check(map: &EnvMap, normals: &[DVec3], reference: &[f64]) -> f64 {
     (normals.par_iter().zip(reference))
         .map(|(n, r)| {
             let mut total = 0.0;
-            for j in 0..h {
-                let (i_s, i_c, radius) = rows[j];
+            for (j, &(i_s, i_c, radius)) in rows.iter().enumerate() {
                 for i in 0..w {
                     let l = map.values()[j * w + i];
                     if l == 0.0 {
