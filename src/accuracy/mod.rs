@@ -180,6 +180,9 @@ struct Scenario<'a, P> {
 /// ```
 /// let results = tessera::accuracy::run(&tessera::accuracy::Config::tiny());
 /// assert!(results.rows.iter().any(|r| r.scenario == "plane-uniform" && r.method == "bridson"));
+/// let stratified = |r: &&tessera::accuracy::Row| r.method == "stratified inverse-CDF";
+/// assert!(results.rows.iter().filter(stratified).all(|r| r.scenario == "sphere-envmap"));
+/// assert!(results.rows.iter().filter(stratified).any(|r| r.rel_rmse > 0.0));
 /// ```
 pub fn run(config: &Config) -> Results {
     let start = Instant::now();

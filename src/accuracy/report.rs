@@ -185,8 +185,10 @@ impl Results {
              sqrt(mean((estimate − I)² / I²)) over the seeds and the median time to draw one \
              set on one thread (randomisation included). Randomisation: a uniformly random \
              rotation on the sphere (`tessera sphere --map ... --seed`: the env-map sampler \
-             rotates its frame), a toroidal shift in the unit square; i.i.d., Sobol (Owen \
-             scrambling), jittered HEALPix and Bridson draw from the seed. Slopes are \
+             rotates its frame), a toroidal shift in the unit square; i.i.d., 1-D stratified \
+             inverse CDF (env map: one uniform number per stratum of the row-major CDF over \
+             all pixels), Sobol (Owen scrambling), jittered HEALPix and Bridson draw from the \
+             seed. Slopes are \
              least-squares fits of log MSE against log N (the mean count actually drawn).\n",
             self.config.seeds
         );

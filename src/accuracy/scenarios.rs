@@ -13,7 +13,7 @@
 //!   knob only matters under a varying density.
 
 use super::{integrands, Generator, Method, Scenario};
-use crate::baselines::envmap::{AliasTable, InverseCdf};
+use crate::baselines::envmap::{AliasTable, InverseCdf, Stratified};
 use crate::baselines::{
     bridson, jittered_grid_2d, jittered_healpix_about, random_rotation, sobol, spherical_fibonacci,
     uniform_random_2d, uniform_random_sphere, SplitMix64,
@@ -141,10 +141,11 @@ where
 /// Importance sampling of the generated sky, Lambertian lobes.
 pub(super) fn sphere_envmap(map: &EnvMap) -> Scenario<'_, DVec3> {
     let sphere = SphereTiling::default;
-    let (inverse, alias, warp) = (
+    let (inverse, alias, warp, stratified) = (
         InverseCdf::new(map),
         AliasTable::new(map),
         InverseCdf::new(map),
+        Stratified::new(map),
     );
     let methods = vec![
         method("tessera", true, move |n, s| {
@@ -167,6 +168,9 @@ pub(super) fn sphere_envmap(map: &EnvMap) -> Scenario<'_, DVec3> {
             inverse.samples(n, s)
         }),
         method("i.i.d. alias", false, move |n, s| alias.samples(n, s)),
+        method("stratified inverse-CDF", false, move |n, s| {
+            stratified.samples(n, s)
+        }),
         method("sobol inverse-CDF", false, move |n, s| {
             let u = sobol::owen_sobol_2d(n, s);
             u.into_iter().map(|u| warp.warp([u.x, u.y])).collect()

@@ -16,13 +16,38 @@ use crate::Error;
 use glam::DVec2;
 
 /// Index `k` with `cdf[k] <= u < cdf[k + 1]` (never a zero-width entry).
-fn search(cdf: &[f64], u: f64) -> usize {
+#[inline]
+pub(crate) fn search(cdf: &[f64], u: f64) -> usize {
     cdf[1..].partition_point(|&c| c <= u).min(cdf.len() - 2)
+}
+
+/// [`search`] for a `u` at or after the `u` that gave `from` (so the
+/// answer is at least `from`): a galloping search forward from `from`,
+/// steps 1, 2, 4, ... then a binary search inside the last step, so a
+/// sorted run of `u` walks the CDF once, in order, touching
+/// `O(log gap)` entries each. The same index as [`search`].
+#[inline]
+pub(crate) fn search_from(cdf: &[f64], from: usize, u: f64) -> usize {
+    let last = cdf.len() - 2; // the largest index
+    if from >= last || cdf[from + 1] > u {
+        return from.min(last);
+    }
+    // the answer is in lo..=last; gallop until cdf[hi + 1] > u
+    let (mut lo, mut step) = (from + 1, 1);
+    let hi = loop {
+        let hi = (lo + step - 1).min(last);
+        if hi == last || cdf[hi + 1] > u {
+            break hi;
+        }
+        lo = hi + 1;
+        step *= 2;
+    };
+    (lo + cdf[lo + 1..=hi + 1].partition_point(|&c| c <= u)).min(last)
 }
 
 /// Running sums of `weights` divided by their total (`None` when it is 0),
 /// with the last entry exactly 1.
-fn normalised_cdf(weights: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
+pub(crate) fn normalised_cdf(weights: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
     let mut cdf = vec![0.0];
     let mut sum = 0.0;
     for w in weights {
@@ -38,7 +63,8 @@ fn normalised_cdf(weights: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
 }
 
 /// Where `u` falls inside CDF entry `k`, in `[0, 1)`.
-fn remainder(cdf: &[f64], k: usize, u: f64) -> f64 {
+#[inline]
+pub(crate) fn remainder(cdf: &[f64], k: usize, u: f64) -> f64 {
     let width = cdf[k + 1] - cdf[k];
     ((u - cdf[k]) / width).clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }
@@ -103,6 +129,7 @@ impl GridCdf {
     /// assert_eq!((i, j), (0, 1));
     /// assert!((t[0] - 0.5).abs() < 1e-12 && (t[1] - 0.5).abs() < 1e-12);
     /// ```
+    #[inline]
     pub fn locate(&self, u: [f64; 2]) -> (usize, usize, [f64; 2]) {
         let j = search(&self.marginal, u[0]);
         let row = &self.conditional[j * (self.width + 1)..(j + 1) * (self.width + 1)];
