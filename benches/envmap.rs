@@ -15,7 +15,7 @@ mod sky;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
-use tessera::baselines::envmap::{AliasTable, InverseCdf};
+use tessera::baselines::envmap::{AliasTable, InverseCdf, Stratified};
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::engine::{self, Order};
 use tessera::io::image::{read_raster, ReadOptions};
@@ -79,6 +79,10 @@ fn per_sample(c: &mut Criterion) {
     });
     group.bench_function("alias_1_thread", |b| {
         b.iter(|| black_box(alias.samples(N, 1)))
+    });
+    let stratified = Stratified::new(&map);
+    group.bench_function("stratified_1_thread", |b| {
+        b.iter(|| black_box(stratified.samples(N, 1)))
     });
     group.finish();
 }
