@@ -57,27 +57,11 @@
 
 use crate::density::{Density, Region};
 use crate::memory;
+pub use crate::sample::Sample;
 use crate::tiling::{code_value, Code, TileSystem};
 use crate::Error;
 use rayon::prelude::*;
 use std::ops::Range;
-
-/// A generated sample.
-///
-/// # Example
-/// ```
-/// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
-/// let samples = engine::generate(&SphereTiling::default(), &Uniform, 10, true).unwrap();
-/// assert_eq!(samples.len(), 10);
-/// assert!(samples.windows(2).all(|w| w[0].rank <= w[1].rank));
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sample<P> {
-    /// Where the sample is.
-    pub position: P,
-    /// Progressive rank in `[0, 1)`: smaller ranks survive smaller requests.
-    pub rank: f64,
-}
 
 /// Every sample the tiling accepts when `magnitude` samples are expected
 /// over the whole domain, in root order

@@ -432,6 +432,18 @@ pub fn vec_to_angles(v: DVec3) -> (f64, f64) {
     (theta, phi + 0.0)
 }
 
+/// Unit vector of a longitude and latitude in degrees (Z up).
+///
+/// # Example
+/// ```
+/// let v = tessera::healpix::lonlat_to_vec(0.0, 90.0);
+/// assert!((v.z - 1.0).abs() < 1e-15);
+/// ```
+pub fn lonlat_to_vec(lon_deg: f64, lat_deg: f64) -> DVec3 {
+    let (lon, lat) = (lon_deg.to_radians(), lat_deg.to_radians());
+    DVec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin())
+}
+
 /// Longitude in `[-180, 180)` and latitude in `[-90, 90]`, in degrees, of a (not necessarily
 /// normalised) vector.
 ///

@@ -24,10 +24,14 @@ pub mod lut;
 mod memory;
 pub mod metrics;
 pub mod optimize;
+pub mod plot;
+pub mod polyomino;
+pub mod random;
+mod sample;
 mod sampler;
 pub mod synth;
 pub mod tiling;
 
-pub use engine::Sample;
 pub use error::Error;
+pub use sample::Sample;
 pub use sampler::Sampler;

@@ -4,10 +4,18 @@
 //! version; `luts/*.provenance.json` beside it records the command, seed,
 //! parameters and resulting metrics. `tessera lut build` regenerates both.
 
-use crate::tiling::polyomino::{Lattice, Placement, Rule};
+use crate::polyomino::{Lattice, Placement, Rule};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};
+
+/// Pentominoes per sphere face at level 0: a sphere table holds a rule for
+/// each of a face's roots.
+pub const ROOTS_PER_FACE: usize = 20;
+/// Number of level-0 tiles on the sphere.
+pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
+/// Most cells a planar rep-tile of a table may have.
+pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
 pub const SPHERE_LUT_VERSION: u32 = 3;
@@ -136,7 +144,7 @@ impl SphereLut {
     /// ```
     /// let lut = tessera::lut::sphere_lut();
     /// let o = lut.offset(0, 0, lut.bins() - 1);
-    /// assert!(tessera::tiling::polyomino::Shape::p_pentomino().contains(o));
+    /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
         let table = &self.tables[level.min(self.tables.len() - 1)];
@@ -155,7 +163,7 @@ impl SphereLut {
     /// Checks every index the run-time recursion will follow.
     fn validate(&self) -> Result<(), Error> {
         let bad = |what: &str| Err(Error::Table(format!("sphere table: {what}")));
-        let roots = crate::tiling::sphere::ROOT_COUNT;
+        let roots = ROOT_COUNT;
         if self.rules.len() != 2 || self.rules.iter().any(|r| r.children.len() != 4) {
             return bad("expected two rules of four children");
         }
@@ -327,7 +335,7 @@ pub struct PlaneLut {
     /// Seed the optimiser ran with.
     pub seed: u64,
     /// The rep-tile.
-    pub shape: crate::tiling::polyomino::Shape,
+    pub shape: crate::polyomino::Shape,
     /// Its production rules (all with the same scale and child count `A`).
     pub rules: Vec<Rule>,
     /// `child_rule[rule][child]`: the rule a child subdivides with.
@@ -452,7 +460,7 @@ impl PlaneLut {
         let bad = |what: &str| Err(Error::Table(format!("planar table: {what}")));
         let a = self.arity();
         let cells = self.shape.cells().len();
-        if !(2..=256).contains(&a) || !(1..=crate::tiling::plane::MAX_CELLS).contains(&cells) {
+        if !(2..=256).contains(&a) || !(1..=MAX_CELLS).contains(&cells) {
             return bad("the shape needs 1..=8 cells and 2..=256 children per rule");
         }
         let scale = self.rules[0].scale;

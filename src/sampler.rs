@@ -1,10 +1,12 @@
 //! The builder most users start from.
 
+use crate::density::envmap::EnvMap;
 use crate::density::{Density, Region, Uniform};
 use crate::engine::{self, Order, Sample};
 use crate::tiling::sphere::SphereTiling;
 use crate::tiling::TileSystem;
 use crate::Error;
+use glam::DVec3;
 
 /// A configured sampling request: a tile system, a density and a count.
 ///
@@ -217,6 +219,30 @@ where
         let mut samples = engine::generate_ordered(&self.system, &density, count, exact, order)?;
         for s in &mut samples {
             s.position = rect.to_world(s.position);
+        }
+        Ok(samples)
+    }
+}
+
+/// Sampling an environment map directly (it lives here, beside the other
+/// entry points, so that densities do not depend on the engine).
+impl EnvMap {
+    /// Exactly `count` samples of the map in progressive order, in world
+    /// directions (the sphere tiling with the shipped tables).
+    ///
+    /// # Example
+    /// ```
+    /// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster};
+    /// let map = EnvMap::new(Raster { width: 2, height: 1, values: vec![1.0, 3.0], bad_pixels: 0 }, Up::Z).unwrap();
+    /// assert_eq!(map.generate(100).unwrap().len(), 100);
+    /// ```
+    pub fn generate(&self, count: usize) -> Result<Vec<Sample<DVec3>>, Error> {
+        let tiling = SphereTiling::default();
+        let mut samples = engine::generate(&tiling, self, count, true)?;
+        if self.seed().is_some() {
+            for s in &mut samples {
+                s.position = self.to_world(s.position);
+            }
         }
         Ok(samples)
     }

@@ -258,14 +258,21 @@ fn modules_form_no_cycle() {
         for (a, b) in &edges {
             let inside = |m: &Vec<String>| m.len() > depth && m[..depth] == folder[..];
             if inside(a) && inside(b) && a[depth] != b[depth] {
-                graph.entry(a[depth].clone()).or_default().insert(b[depth].clone());
+                graph
+                    .entry(a[depth].clone())
+                    .or_default()
+                    .insert(b[depth].clone());
             }
         }
         if let Some(cycle) = a_cycle(&graph) {
             failures.push(format!("in {}/: {}", folder.join("/"), cycle.join(" -> ")));
         }
     }
-    assert!(failures.is_empty(), "module cycles:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "module cycles:\n{}",
+        failures.join("\n")
+    );
 }
 
 #[test]

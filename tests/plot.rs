@@ -1,7 +1,7 @@
 //! Pictures: PNGs decode at the right size and points land in the right pixels.
 
 use glam::{DVec2, DVec3};
-use tessera::io::plot::{
+use tessera::plot::{
     equirectangular, line_plot, log_image, orthographic, stipple, Axes, Series, PALETTE,
 };
 

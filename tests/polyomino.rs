@@ -1,7 +1,7 @@
 //! Polyomino geometry and the rep-tile rules stored in luts/.
 
 use proptest::prelude::*;
-use tessera::tiling::polyomino::{Orientation, Rule, Shape};
+use tessera::polyomino::{Orientation, Rule, Shape};
 
 fn stored_rules(name: &str) -> (Shape, Vec<Rule>) {
     let path = format!("{}/luts/{name}.rules.json", env!("CARGO_MANIFEST_DIR"));
@@ -64,7 +64,7 @@ proptest! {
         prop_assert_eq!(a.then(b).apply((x, y)), b.apply(a.apply((x, y))));
         prop_assert_eq!(a.inverse().apply(a.apply((x, y))), (x, y));
         // lattice cells map to lattice cells, and placements keep cell counts
-        let p = tessera::tiling::polyomino::Placement::new((x, y), a);
+        let p = tessera::polyomino::Placement::new((x, y), a);
         let cells: std::collections::HashSet<_> = p.cells(&Shape::g_hexomino()).collect();
         prop_assert_eq!(cells.len(), 6);
     }

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 use tessera::density::sphere::{angle_between, Cap};
 use tessera::density::Uniform;
 use tessera::healpix::FacePoint;
-use tessera::tiling::polyomino::{Rule, Shape};
+use tessera::polyomino::{Rule, Shape};
 use tessera::tiling::sphere::{SphereTiling, FACE_LIPSCHITZ};
 use tessera::tiling::TileSystem;
 use tessera::{engine, Sampler};

@@ -1,7 +1,7 @@
 //! `ACCURACY.md` and its plots from [`Results`].
 
 use super::{Results, Row};
-use crate::io::plot::{line_plot, Axes, Series, PALETTE, PALETTE_NAMES};
+use crate::plot::{line_plot, Axes, Series, PALETTE, PALETTE_NAMES};
 use crate::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -638,7 +638,7 @@ fn tiles(args: TilesArgs) -> Result<(), Error> {
             .iter()
             .map(|s| s.position)
             .collect();
-    let svg = tessera::io::svg::plane_tiles(&tiling, args.level, &points);
+    let svg = tessera::plot::svg::plane_tiles(&tiling, args.level, &points);
     std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
 }
 
@@ -658,7 +658,7 @@ fn penrose_tiles(args: TilesArgs) -> Result<(), Error> {
             .iter()
             .map(|s| s.position)
             .collect();
-    let svg = tessera::io::svg::penrose_tiles(&tiling, args.level, &points);
+    let svg = tessera::plot::svg::penrose_tiles(&tiling, args.level, &points);
     std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
 }
 
@@ -677,7 +677,7 @@ fn sphere_tiles(args: TilesArgs) -> Result<(), Error> {
             .iter()
             .map(|s| s.position)
             .collect();
-    let svg = tessera::io::svg::sphere_tiles(&tiling, args.level, &points);
+    let svg = tessera::plot::svg::sphere_tiles(&tiling, args.level, &points);
     std::fs::write(&args.svg, svg).map_err(io_error(&args.svg))
 }
 
@@ -833,7 +833,7 @@ where
 const SPECTRUM_L_MAX: usize = 64;
 
 fn metrics(args: MetricsArgs) -> Result<(), Error> {
-    use tessera::io::plot;
+    use tessera::plot;
     let report = match args.domain {
         Domain::Sphere => {
             let points = read_sphere_points(&args.file)?;
@@ -877,7 +877,7 @@ fn metrics(args: MetricsArgs) -> Result<(), Error> {
 }
 
 fn plot(args: PlotArgs) -> Result<(), Error> {
-    use tessera::io::plot;
+    use tessera::plot;
     match (args.domain, args.view) {
         (Domain::Plane, _) => {
             let points = read_plane_points(&args.file)?;
@@ -927,7 +927,7 @@ fn bench_accuracy(args: AccuracyArgs) -> Result<(), Error> {
 }
 
 fn lut_tiling(args: LutTilingArgs) -> Result<(), Error> {
-    use tessera::tiling::polyomino::{Rule, Shape};
+    use tessera::polyomino::{Rule, Shape};
     let (name, shape, scale, limit) = match args.tile {
         RepTile::Ghexomino => ("ghexomino", Shape::g_hexomino(), 9, 1),
         RepTile::Ppentomino => ("ppentomino", Shape::p_pentomino(), 2, usize::MAX),

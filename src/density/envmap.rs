@@ -27,9 +27,9 @@
 //! ```
 
 use super::Density;
-use crate::baselines::random_rotation;
 use crate::healpix::FacePoint;
 use crate::io::image::{read_raster, Raster, ReadOptions};
+use crate::random::random_rotation;
 use crate::tiling::sphere::SphereRegion;
 use crate::Error;
 use glam::{DMat3, DVec3};
@@ -532,7 +532,7 @@ impl EnvMap {
     /// let s = map.generate(8).unwrap();
     /// assert!(map.pdfs(&s).iter().all(|&p| p > 0.0));
     /// ```
-    pub fn pdfs(&self, samples: &[crate::Sample<DVec3>]) -> Vec<f64> {
+    pub fn pdfs(&self, samples: &[crate::sample::Sample<DVec3>]) -> Vec<f64> {
         samples.iter().map(|s| self.pdf(s.position)).collect()
     }
 
@@ -546,26 +546,6 @@ impl EnvMap {
     /// ```
     pub fn to_world(&self, p: DVec3) -> DVec3 {
         self.rotation * p
-    }
-
-    /// Exactly `count` samples of the map in progressive order, in world
-    /// directions (the sphere tiling with the shipped tables).
-    ///
-    /// # Example
-    /// ```
-    /// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster};
-    /// let map = EnvMap::new(Raster { width: 2, height: 1, values: vec![1.0, 3.0], bad_pixels: 0 }, Up::Z).unwrap();
-    /// assert_eq!(map.generate(100).unwrap().len(), 100);
-    /// ```
-    pub fn generate(&self, count: usize) -> Result<Vec<crate::Sample<DVec3>>, Error> {
-        let tiling = crate::tiling::sphere::SphereTiling::default();
-        let mut samples = crate::engine::generate(&tiling, self, count, true)?;
-        if self.rotation != DMat3::IDENTITY {
-            for s in &mut samples {
-                s.position = self.to_world(s.position);
-            }
-        }
-        Ok(samples)
     }
 
     /// The world direction at `(u, v)` in `[0, 1)^2` of pixel (column `i`,
@@ -769,8 +749,8 @@ impl Density<SphereRegion> for EnvMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::baselines::SplitMix64;
     use crate::healpix::vec_to_angles;
+    use crate::random::SplitMix64;
 
     #[test]
     fn fast_atan2_is_within_its_error() {

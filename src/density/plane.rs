@@ -315,7 +315,7 @@ pub struct Shifted<D> {
 }
 
 impl<D> Shifted<D> {
-    /// `inner` shifted by two numbers of [`crate::baselines::SplitMix64`]`(seed)`.
+    /// `inner` shifted by two numbers of [`crate::random::SplitMix64`]`(seed)`.
     ///
     /// # Example
     /// ```
@@ -324,7 +324,7 @@ impl<D> Shifted<D> {
     /// assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
     /// ```
     pub fn new(inner: D, seed: u64) -> Self {
-        let mut rng = crate::baselines::SplitMix64::new(seed);
+        let mut rng = crate::random::SplitMix64::new(seed);
         let shift = DVec2::new(rng.next_f64(), rng.next_f64());
         Shifted { inner, shift, seed }
     }

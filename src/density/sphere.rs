@@ -19,17 +19,7 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// Unit vector of a longitude and latitude in degrees (Z up).
-///
-/// # Example
-/// ```
-/// let v = tessera::density::sphere::lonlat_to_vec(0.0, 90.0);
-/// assert!((v.z - 1.0).abs() < 1e-15);
-/// ```
-pub fn lonlat_to_vec(lon_deg: f64, lat_deg: f64) -> DVec3 {
-    let (lon, lat) = (lon_deg.to_radians(), lat_deg.to_radians());
-    DVec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin())
-}
+pub use crate::healpix::lonlat_to_vec;
 
 /// Density `contrast` inside a spherical cap and 1 outside.
 ///
@@ -375,7 +365,7 @@ pub struct Rotated<D> {
 }
 
 impl<D> Rotated<D> {
-    /// `inner` in the frame of [`crate::baselines::random_rotation`]`(seed)`.
+    /// `inner` in the frame of [`crate::random::random_rotation`]`(seed)`.
     ///
     /// # Example
     /// ```
@@ -386,7 +376,7 @@ impl<D> Rotated<D> {
     pub fn new(inner: D, seed: u64) -> Self {
         Rotated {
             inner,
-            rotation: crate::baselines::random_rotation(seed),
+            rotation: crate::random::random_rotation(seed),
             seed,
         }
     }

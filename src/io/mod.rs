@@ -1,7 +1,5 @@
-//! Point-set formats (UTK-style text and binary), drawings, PNG pictures and
-//! raster readers.
+//! Files: point-set formats (UTK-style text and binary, CSV, GeoJSON) and
+//! raster readers. Pictures are [`crate::plot`]'s.
 
 pub mod image;
-pub mod plot;
 pub mod points;
-pub mod svg;

@@ -188,7 +188,7 @@ fn read_geojson(bytes: &[u8]) -> Result<Vec<Vec<f64>>, String> {
                 .map(|a| a.iter().map(|x| x.as_f64()).collect::<Option<Vec<f64>>>());
             match pair {
                 Some(Some(v)) if v.len() >= 2 && v[1].abs() <= 90.0 && v[0].is_finite() => {
-                    let p = crate::density::sphere::lonlat_to_vec(v[0], v[1]);
+                    let p = crate::healpix::lonlat_to_vec(v[0], v[1]);
                     Ok(vec![p.x, p.y, p.z])
                 }
                 _ => Err("a Point's coordinates are not [lon, lat] in degrees".to_string()),
@@ -347,7 +347,7 @@ fn read_text(bytes: &[u8], dims: usize) -> Result<Vec<Vec<f64>>, String> {
                     number + 1
                 ));
             }
-            let v = crate::density::sphere::lonlat_to_vec(lon, lat);
+            let v = crate::healpix::lonlat_to_vec(lon, lat);
             points.push(vec![v.x, v.y, v.z]);
         } else {
             points.push(row);

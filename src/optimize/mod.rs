@@ -1,7 +1,6 @@
 //! Offline optimisation: tiling searches, rankings and Lloyd relaxation that
 //! produce the tables in `luts/`. Nothing here runs when sampling.
 
-pub mod exact_cover;
 mod lloyd;
 pub mod penrose;
 pub mod plane;

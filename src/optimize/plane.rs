@@ -27,13 +27,13 @@
 //!    matter where the neighbourhoods differ: the G-hexomino's children of
 //!    roots sit in the root patch's arrangement, deeper tiles in the rule's.
 
-use crate::baselines::SplitMix64;
 use crate::lut::{PlaneLut, PlaneSystem, PLANE_LUT_VERSION};
-use crate::optimize::exact_cover::tilings;
 use crate::optimize::lloyd::{cell_moments, torus_d2, wrap_half, TorusGrid};
 use crate::optimize::ranking::farthest_point_ranks;
+use crate::polyomino::exact_cover::tilings;
+use crate::polyomino::{Lattice, Placement, Rule, Shape};
+use crate::random::SplitMix64;
 use crate::tiling::plane::{PlaneTile, PlaneTiling};
-use crate::tiling::polyomino::{Lattice, Placement, Rule, Shape};
 use crate::tiling::TileSystem;
 use crate::Error;
 use rayon::prelude::*;

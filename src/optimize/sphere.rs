@@ -15,11 +15,11 @@
 //!    equal-area quadrature), per level and importance bin, with each
 //!    structural index sharing one offset.
 
-use super::exact_cover;
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
 use crate::lut::{SphereLut, SPHERE_LUT_VERSION};
-use crate::tiling::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
+use crate::polyomino::exact_cover;
+use crate::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
 use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
 use crate::tiling::{Code, TileSystem};
 use crate::Error;

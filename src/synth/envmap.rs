@@ -2,7 +2,7 @@
 
 use super::noise::{blocky, fbm, gaussian, sprinkle_zeros, uniform, zero_lines};
 use super::{luminance_of, SynthMap};
-use crate::baselines::SplitMix64;
+use crate::random::SplitMix64;
 use glam::DVec3;
 use std::collections::BTreeMap;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};

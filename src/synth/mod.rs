@@ -9,7 +9,7 @@
 //! column `i` of a `W x H` map covers `phi in [2 pi i / W, 2 pi (i+1) / W)`,
 //! row `j` (row 0 on top) covers `theta in [j pi / H, (j+1) pi / H]` from
 //! +Z; the upper half is sky, the lower half ground. Everything is
-//! deterministic for a seed (randomness is [`SplitMix64`](crate::baselines::SplitMix64)),
+//! deterministic for a seed (randomness is [`SplitMix64`](crate::random::SplitMix64)),
 //! finite and `>= 0`.
 //!
 //! ```

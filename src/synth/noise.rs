@@ -2,7 +2,7 @@
 //! and the defects lossy compression leaves (zero pixels, zero lines).
 
 use super::SynthMap;
-use crate::baselines::SplitMix64;
+use crate::random::SplitMix64;
 use std::f64::consts::TAU;
 
 /// One standard normal draw (Box-Muller).

@@ -1,7 +1,7 @@
 //! The synthetic planar rasters.
 
 use super::noise::{fbm, uniform};
-use crate::baselines::SplitMix64;
+use crate::random::SplitMix64;
 
 /// A kind of synthetic grey raster for the planar systems, each a feature
 /// that stresses sampling on the unit square: hard edges, gradients,

@@ -6,11 +6,10 @@
 
 pub mod penrose;
 pub mod plane;
-pub mod polyomino;
 pub mod reference;
 pub mod sphere;
 
-use crate::engine::Sample;
+use crate::sample::Sample;
 
 /// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
 /// every system's deepest level (the sphere's level 36 has `240 * 4^36`

@@ -13,16 +13,16 @@
 //! periodically), so a point pushed across the square's border re-enters on
 //! the opposite side: every point lies in `[0, 1)^2`.
 
-use crate::engine::Sample;
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
-use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
+use crate::polyomino::{Lattice, Orientation, Placement, Shape};
+use crate::sample::Sample;
 use crate::tiling::{code_value, mirror_unit, samples_in_code_order, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Most cells a planar rep-tile may have (the size of [`PlaneRegion::cells`]).
-pub const MAX_CELLS: usize = 8;
+pub use crate::lut::MAX_CELLS;
 
 /// A tile of a planar polyomino system.
 ///

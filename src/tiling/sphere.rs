@@ -14,7 +14,7 @@
 
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
-use crate::tiling::polyomino::{Lattice, Placement, Shape};
+use crate::polyomino::{Lattice, Placement, Shape};
 use crate::tiling::{code_value, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -22,10 +22,7 @@ use std::sync::Arc;
 
 /// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
 pub const PATCH_SIDE: Lattice = 10;
-/// Pentominoes per face at level 0.
-pub const ROOTS_PER_FACE: usize = 20;
-/// Number of level-0 tiles on the sphere.
-pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
+pub use crate::lut::{ROOTS_PER_FACE, ROOT_COUNT};
 /// Deepest supported level: a face edge has `10 * 2^k <= 2^40` cells, so a
 /// cell still spans thousands of f64 ulps of face coordinates, and codes
 /// `240 * 4^k` fit [`Code`]; tiles are about 3e-12 rad across.
@@ -258,7 +255,7 @@ impl SphereTiling {
     /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
     /// let sphere = SphereTiling::default();
     /// let o = sphere.offset(&sphere.roots()[0], 1.0);
-    /// assert!(tessera::tiling::polyomino::Shape::p_pentomino().contains(o));
+    /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;

@@ -16,7 +16,7 @@ const HEIGHT: f64 = 720.0;
 /// # Example
 /// ```
 /// use tessera::tiling::sphere::SphereTiling;
-/// let svg = tessera::io::svg::sphere_tiles(&SphereTiling::default(), 0, &[glam::DVec3::X]);
+/// let svg = tessera::plot::svg::sphere_tiles(&SphereTiling::default(), 0, &[glam::DVec3::X]);
 /// assert!(svg.starts_with("<svg") && svg.matches("<polygon").count() >= 240);
 /// ```
 pub fn sphere_tiles(tiling: &SphereTiling, level: u32, points: &[glam::DVec3]) -> String {
@@ -103,7 +103,7 @@ fn unwrap_longitudes(lonlats: &mut [(f64, f64)]) {
 /// # Example
 /// ```
 /// use tessera::tiling::plane::PlaneTiling;
-/// let svg = tessera::io::svg::plane_tiles(&PlaneTiling::ppentomino(), 0, &[glam::DVec2::splat(0.5)]);
+/// let svg = tessera::plot::svg::plane_tiles(&PlaneTiling::ppentomino(), 0, &[glam::DVec2::splat(0.5)]);
 /// assert_eq!(svg.matches("<polygon").count(), 20);
 /// assert_eq!(svg.matches("<text").count(), 20);
 /// ```
@@ -154,7 +154,7 @@ pub fn plane_tiles(
 /// # Example
 /// ```
 /// use tessera::tiling::penrose::PenroseTiling;
-/// let svg = tessera::io::svg::penrose_tiles(&PenroseTiling::default(), 4, &[glam::DVec2::splat(0.5)]);
+/// let svg = tessera::plot::svg::penrose_tiles(&PenroseTiling::default(), 4, &[glam::DVec2::splat(0.5)]);
 /// assert!(svg.matches("<polygon").count() > 10);
 /// assert!(svg.contains("<text") && svg.contains("<circle"));
 /// ```

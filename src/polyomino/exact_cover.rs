@@ -3,7 +3,7 @@
 //! Used offline to find polyomino dissections: the two 4-rep rules of the
 //! P-pentomino, the 20-tile patch of a 10x10 face, the 81-rep G-hexomino rule.
 
-use crate::tiling::polyomino::{Lattice, Orientation, Placement, Shape};
+use super::{Lattice, Orientation, Placement, Shape};
 use std::collections::HashSet;
 
 /// Every placement of `shape` (any of the 8 orientations, any translation)
@@ -11,8 +11,8 @@ use std::collections::HashSet;
 ///
 /// # Example
 /// ```
-/// use tessera::optimize::exact_cover::placements_in;
-/// use tessera::tiling::polyomino::Shape;
+/// use tessera::polyomino::exact_cover::placements_in;
+/// use tessera::polyomino::Shape;
 /// let domino = Shape::new(vec![(0, 0), (1, 0)]);
 /// let square: Vec<(i64, i64)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
 /// // two horizontal and two vertical dominoes fit in a 2x2 square
@@ -50,8 +50,8 @@ pub fn placements_in(shape: &Shape, region: &[(Lattice, Lattice)]) -> Vec<Placem
 ///
 /// # Example
 /// ```
-/// use tessera::optimize::exact_cover::tilings;
-/// use tessera::tiling::polyomino::Shape;
+/// use tessera::polyomino::exact_cover::tilings;
+/// use tessera::polyomino::Shape;
 /// let domino = Shape::new(vec![(0, 0), (1, 0)]);
 /// let square: Vec<(i64, i64)> = vec![(0, 0), (1, 0), (0, 1), (1, 1)];
 /// assert_eq!(tilings(&domino, &square, usize::MAX, 0).len(), 2);
@@ -155,7 +155,7 @@ impl Search<'_> {
 
 /// Deterministic Fisher-Yates shuffle.
 fn shuffle<T>(items: &mut [T], seed: u64) {
-    let mut rng = crate::baselines::SplitMix64::new(seed);
+    let mut rng = crate::random::SplitMix64::new(seed);
     for i in (1..items.len()).rev() {
         items.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
     }

@@ -5,6 +5,8 @@
 //! lattice, with `T` one of the 8 orthogonal integer matrices. Children of a
 //! `scale`-rep tile live on the lattice refined `scale` times.
 
+pub mod exact_cover;
+
 use serde::{Deserialize, Serialize};
 
 /// A lattice coordinate. 64 bits keep deep levels exact: the sphere's
@@ -12,7 +14,7 @@ use serde::{Deserialize, Serialize};
 ///
 /// # Example
 /// ```
-/// let side: tessera::tiling::polyomino::Lattice = 10 << 40;
+/// let side: tessera::polyomino::Lattice = 10 << 40;
 /// assert!(side > i32::MAX as i64);
 /// ```
 pub type Lattice = i64;
@@ -22,7 +24,7 @@ pub type Lattice = i64;
 ///
 /// # Example
 /// ```
-/// use tessera::tiling::polyomino::Orientation;
+/// use tessera::polyomino::Orientation;
 /// let quarter = Orientation::new(1, false);
 /// assert_eq!(quarter.apply((1, 0)), (0, 1));
 /// assert_eq!(quarter.then(quarter).then(quarter).then(quarter), Orientation::IDENTITY);
@@ -36,7 +38,7 @@ pub struct Orientation(u8);
 ///
 /// # Example
 /// ```
-/// use tessera::tiling::polyomino::Orientation;
+/// use tessera::polyomino::Orientation;
 /// assert_eq!(Orientation::try_from(5).unwrap().index(), 5);
 /// assert!(Orientation::try_from(8).is_err());
 /// ```
@@ -56,7 +58,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::IDENTITY.apply((2, 3)), (2, 3));
     /// ```
     pub const IDENTITY: Orientation = Orientation(0);
@@ -65,7 +67,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::ALL.len(), 8);
     /// ```
     pub const ALL: [Orientation; 8] = [
@@ -83,7 +85,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::new(2, true).apply((1, 2)), (1, -2));
     /// ```
     pub fn new(turns: u8, mirrored: bool) -> Self {
@@ -94,7 +96,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::new(3, true).index(), 7);
     /// ```
     pub fn index(self) -> usize {
@@ -105,7 +107,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::from_index(5).index(), 5);
     /// ```
     pub fn from_index(index: usize) -> Self {
@@ -116,7 +118,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::IDENTITY.matrix(), [[1, 0], [0, 1]]);
     /// ```
     pub fn matrix(self) -> [[Lattice; 2]; 2] {
@@ -127,7 +129,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::new(0, true).apply((1, 1)), (-1, 1));
     /// ```
     pub fn apply(self, v: (Lattice, Lattice)) -> (Lattice, Lattice) {
@@ -139,7 +141,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// assert_eq!(Orientation::new(1, false).apply_f64([0.5, 0.0]), [0.0, 0.5]);
     /// ```
     #[inline]
@@ -155,7 +157,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// let (a, b) = (Orientation::new(1, false), Orientation::new(0, true));
     /// assert_eq!(a.then(b).apply((1, 0)), b.apply(a.apply((1, 0))));
     /// ```
@@ -167,7 +169,7 @@ impl Orientation {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Orientation;
+    /// use tessera::polyomino::Orientation;
     /// let o = Orientation::new(1, true);
     /// assert_eq!(o.then(o.inverse()), Orientation::IDENTITY);
     /// ```
@@ -267,7 +269,7 @@ const INVERSE: [u8; 8] = {
 ///
 /// # Example
 /// ```
-/// use tessera::tiling::polyomino::Shape;
+/// use tessera::polyomino::Shape;
 /// let p = Shape::p_pentomino();
 /// assert_eq!(p.cells().len(), 5);
 /// assert_eq!(p.bounding_size(), (2, 3));
@@ -282,7 +284,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::new(vec![(0, 0), (1, 0)]).cells().len(), 2);
     /// ```
     pub fn new(cells: Vec<(Lattice, Lattice)>) -> Self {
@@ -294,7 +296,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert!(Shape::p_pentomino().cells().contains(&(0, 0)));
     /// ```
     pub fn p_pentomino() -> Self {
@@ -305,7 +307,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::g_hexomino().cells().len(), 6);
     /// ```
     pub fn g_hexomino() -> Self {
@@ -316,7 +318,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::p_pentomino().cells()[0], (0, 0));
     /// ```
     pub fn cells(&self) -> &[(Lattice, Lattice)] {
@@ -327,7 +329,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::g_hexomino().bounding_size(), (3, 3));
     /// ```
     pub fn bounding_size(&self) -> (Lattice, Lattice) {
@@ -340,7 +342,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::p_pentomino().scaled(2).cells().len(), 20);
     /// ```
     pub fn scaled(&self, factor: Lattice) -> Shape {
@@ -359,7 +361,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::new(vec![(0, 0), (1, 0)]).centroid(), [1.0, 0.5]);
     /// ```
     pub fn centroid(&self) -> [f64; 2] {
@@ -373,7 +375,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// let p = Shape::p_pentomino();
     /// assert!(p.contains([0.5, 0.5]));
     /// assert!(!p.contains([1.5, 0.5]));
@@ -388,7 +390,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// let q = Shape::p_pentomino().clamp([1.7, 0.2], 0.01);
     /// assert!(Shape::p_pentomino().contains(q));
     /// ```
@@ -415,7 +417,7 @@ impl Shape {
 ///
 /// # Example
 /// ```
-/// use tessera::tiling::polyomino::{Orientation, Placement, Shape};
+/// use tessera::polyomino::{Orientation, Placement, Shape};
 /// let p = Placement::new((5, 0), Orientation::new(1, false));
 /// let cells: Vec<_> = p.cells(&Shape::new(vec![(0, 0), (1, 0)])).collect();
 /// assert_eq!(cells, vec![(4, 0), (4, 1)]);
@@ -433,7 +435,7 @@ impl Placement {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// use tessera::polyomino::{Orientation, Placement};
     /// assert_eq!(Placement::new((1, 2), Orientation::IDENTITY).origin, (1, 2));
     /// ```
     pub fn new(origin: (Lattice, Lattice), orientation: Orientation) -> Self {
@@ -447,7 +449,7 @@ impl Placement {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Orientation, Placement, Shape};
+    /// use tessera::polyomino::{Orientation, Placement, Shape};
     /// let p = Placement::new((0, 0), Orientation::new(2, false));
     /// let cells: Vec<_> = p.cells(&Shape::new(vec![(0, 0)])).collect();
     /// assert_eq!(cells, vec![(-1, -1)]);
@@ -464,7 +466,7 @@ impl Placement {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// use tessera::polyomino::{Orientation, Placement};
     /// let p = Placement::new((2, 0), Orientation::new(1, false));
     /// assert_eq!(p.to_lattice([1.0, 0.5]), [1.5, 1.0]);
     /// ```
@@ -478,7 +480,7 @@ impl Placement {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Orientation, Placement};
+    /// use tessera::polyomino::{Orientation, Placement};
     /// let parent = Placement::new((1, 1), Orientation::IDENTITY);
     /// let child = parent.child(&Placement::new((1, 0), Orientation::IDENTITY), 2);
     /// assert_eq!(child.origin, (3, 2));
@@ -511,7 +513,7 @@ fn cell_image(
 ///
 /// # Example
 /// ```
-/// use tessera::tiling::polyomino::{Shape, Rule};
+/// use tessera::polyomino::{Shape, Rule};
 /// let rules = Rule::p_pentomino_rules();
 /// assert_eq!(rules.len(), 2);
 /// assert!(rules[0].tiles_parent(&Shape::p_pentomino()));
@@ -530,7 +532,7 @@ impl Rule {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Shape, Rule};
+    /// use tessera::polyomino::{Shape, Rule};
     /// for rule in Rule::p_pentomino_rules() {
     ///     assert!(rule.tiles_parent(&Shape::p_pentomino()));
     /// }
@@ -553,13 +555,13 @@ impl Rule {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::{Rule, Shape};
+    /// use tessera::polyomino::{Rule, Shape};
     /// let rules = Rule::dissections(&Shape::p_pentomino(), 2, usize::MAX);
     /// assert_eq!(rules.len(), 2);
     /// ```
     pub fn dissections(shape: &Shape, scale: Lattice, limit: usize) -> Vec<Rule> {
         let region = shape.scaled(scale).cells().to_vec();
-        let mut found = crate::optimize::exact_cover::tilings(shape, &region, limit, 0);
+        let mut found = exact_cover::tilings(shape, &region, limit, 0);
         for children in &mut found {
             children.sort_by_key(|p| (p.origin, p.orientation));
         }
@@ -579,7 +581,7 @@ impl Rule {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Rule;
+    /// use tessera::polyomino::Rule;
     /// assert_ne!(Rule::p_pentomino_rules()[0], Rule::p_pentomino_rules()[1]);
     /// ```
     pub fn p_pentomino_rules() -> Vec<Rule> {
@@ -593,7 +595,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::new(vec![(0, 0)]).outline(), vec![(0, 0), (1, 0), (1, 1), (0, 1)]);
     /// assert_eq!(Shape::p_pentomino().outline().len(), 10);
     /// ```
@@ -634,7 +636,7 @@ impl Shape {
     ///
     /// # Example
     /// ```
-    /// use tessera::tiling::polyomino::Shape;
+    /// use tessera::polyomino::Shape;
     /// assert_eq!(Shape::new(vec![(0, 0)]).dilated().cells().len(), 9);
     /// assert!(Shape::p_pentomino().dilated().contains([-0.5, 3.5]));
     /// ```

@@ -4,13 +4,15 @@
 //! labels). Pure functions returning image buffers; saving is the caller's.
 //!
 //! ```
-//! use tessera::io::plot::{line_plot, stipple, Axes, Series};
+//! use tessera::plot::{line_plot, stipple, Axes, Series};
 //! let img = stipple(&[glam::DVec2::new(0.5, 0.5)], 64);
 //! assert_eq!(img.dimensions(), (64, 64));
 //! let s = Series { points: vec![(1.0, 1.0), (10.0, 0.1)], color: [200, 0, 0] };
 //! let plot = line_plot(&[s], Axes { log_x: true, log_y: true }, 320, 240);
 //! assert_eq!(plot.dimensions(), (320, 240));
 //! ```
+
+pub mod svg;
 
 use glam::{DVec2, DVec3};
 use image::{GrayImage, Luma, Rgb, RgbImage};
@@ -20,7 +22,7 @@ use std::f64::consts::{PI, TAU};
 ///
 /// # Example
 /// ```
-/// assert_eq!(tessera::io::plot::PALETTE.len(), tessera::io::plot::PALETTE_NAMES.len());
+/// assert_eq!(tessera::plot::PALETTE.len(), tessera::plot::PALETTE_NAMES.len());
 /// ```
 pub const PALETTE: [[u8; 3]; 16] = [
     [228, 26, 28],
@@ -45,7 +47,7 @@ pub const PALETTE: [[u8; 3]; 16] = [
 ///
 /// # Example
 /// ```
-/// assert_eq!(tessera::io::plot::PALETTE_NAMES[0], "red");
+/// assert_eq!(tessera::plot::PALETTE_NAMES[0], "red");
 /// ```
 pub const PALETTE_NAMES: [&str; 16] = [
     "red", "blue", "green", "purple", "orange", "brown", "pink", "grey", "black", "cyan", "olive",
@@ -82,7 +84,7 @@ fn pixel(t: f64, len: u32) -> i64 {
 ///
 /// # Example
 /// ```
-/// let img = tessera::io::plot::stipple(&[glam::DVec2::new(0.1, 0.1)], 100);
+/// let img = tessera::plot::stipple(&[glam::DVec2::new(0.1, 0.1)], 100);
 /// assert_eq!(img.get_pixel(10, 89)[0], 0);
 /// assert_eq!(img.get_pixel(50, 50)[0], 255);
 /// ```
@@ -107,7 +109,7 @@ pub fn stipple(points: &[DVec2], size: u32) -> GrayImage {
 /// # Example
 /// ```
 /// use glam::DVec3;
-/// let img = tessera::io::plot::equirectangular(&[DVec3::X, DVec3::Z], 200);
+/// let img = tessera::plot::equirectangular(&[DVec3::X, DVec3::Z], 200);
 /// assert_eq!(img.dimensions(), (200, 100));
 /// assert_eq!(img.get_pixel(100, 50)[0], 0); // +x: longitude 0 on the equator
 /// assert_eq!(img.get_pixel(100, 0)[0], 0); // the north pole
@@ -133,7 +135,7 @@ pub fn equirectangular(points: &[DVec3], width: u32) -> GrayImage {
 /// ```
 /// use glam::DVec3;
 /// let near_z = DVec3::new(0.1, 0.0, 1.0).normalize();
-/// let img = tessera::io::plot::orthographic(&[DVec3::X, -DVec3::X, near_z], 101, DVec3::X);
+/// let img = tessera::plot::orthographic(&[DVec3::X, -DVec3::X, near_z], 101, DVec3::X);
 /// assert_eq!(img.get_pixel(50, 50)[0], 0); // +x faces the viewer: the centre
 /// assert_eq!(img.get_pixel(50, 0)[0], 0); // near +z: top of the disc
 /// ```
@@ -168,7 +170,7 @@ pub fn orthographic(points: &[DVec3], size: u32, toward: DVec3) -> GrayImage {
 ///
 /// # Example
 /// ```
-/// let img = tessera::io::plot::log_image(&[1.0, 10.0, 100.0, 0.0], 2);
+/// let img = tessera::plot::log_image(&[1.0, 10.0, 100.0, 0.0], 2);
 /// assert_eq!(img.get_pixel(0, 0)[0], 255); // value 100: top-left
 /// assert_eq!(img.get_pixel(0, 1)[0], 0); // value 1, bottom-left
 /// ```
@@ -201,7 +203,7 @@ pub fn log_image(values: &[f64], size: usize) -> GrayImage {
 ///
 /// # Example
 /// ```
-/// let s = tessera::io::plot::Series { points: vec![(0.0, 1.0)], color: [0, 0, 0] };
+/// let s = tessera::plot::Series { points: vec![(0.0, 1.0)], color: [0, 0, 0] };
 /// assert_eq!(s.points.len(), 1);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
@@ -216,7 +218,7 @@ pub struct Series {
 ///
 /// # Example
 /// ```
-/// let loglog = tessera::io::plot::Axes { log_x: true, log_y: true };
+/// let loglog = tessera::plot::Axes { log_x: true, log_y: true };
 /// assert!(loglog.log_x);
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -353,7 +355,7 @@ fn tick_text(v: f64, log: bool) -> String {
 ///
 /// # Example
 /// ```
-/// use tessera::io::plot::{line_plot, Axes, Series};
+/// use tessera::plot::{line_plot, Axes, Series};
 /// let s = Series { points: vec![(1.0, 1.0), (100.0, 0.01)], color: [255, 0, 0] };
 /// let img = line_plot(&[s], Axes { log_x: true, log_y: true }, 400, 300);
 /// assert!(img.pixels().any(|p| p.0 == [255, 0, 0]));
@@ -425,7 +427,7 @@ pub fn line_plot(series: &[Series], axes: Axes, width: u32, height: u32) -> RgbI
 /// # Example
 /// ```
 /// use tessera::{baselines::uniform_random_2d, metrics::plane::PlaneSpectrum};
-/// let img = tessera::io::plot::plane_spectrum_figure(&PlaneSpectrum::new(&uniform_random_2d(64, 1)));
+/// let img = tessera::plot::plane_spectrum_figure(&PlaneSpectrum::new(&uniform_random_2d(64, 1)));
 /// assert_eq!(img.dimensions(), (768, 256));
 /// ```
 pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) -> RgbImage {
@@ -460,7 +462,7 @@ pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) ->
 ///
 /// # Example
 /// ```
-/// let img = tessera::io::plot::angular_power_figure(&[4.0, 0.5, 0.8, 1.1]);
+/// let img = tessera::plot::angular_power_figure(&[4.0, 0.5, 0.8, 1.1]);
 /// assert_eq!(img.dimensions(), (640, 360));
 /// ```
 pub fn angular_power_figure(power: &[f64]) -> RgbImage {
