@@ -471,8 +471,7 @@ fn strict_passes_codec_noise_and_refuses_damage() {
     let path = dir.join("damaged.exr");
     map.write_exr(&path, false).unwrap();
     let e = tessera::io::image::read_raster(&path, &strict)
-        .err()
-        .expect("damage is refused")
+        .expect_err("damage is refused")
         .to_string();
     assert!(
         e.contains("column 10, row 20") && e.contains("beyond codec noise"),
