@@ -1,0 +1,152 @@
+//! Helpers the subcommands share: the request arguments, output files, point files and pictures.
+
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use tessera::density::{Density, Region};
+use tessera::engine::{Order, Sample};
+use tessera::tiling::TileSystem;
+use tessera::{engine, Error};
+
+/// What every sampling command asks for: how many samples, and where to.
+#[derive(Args)]
+pub(crate) struct RequestArgs {
+    /// Number of samples (exact unless --expected).
+    #[arg(short = 'n', long = "count")]
+    pub(crate) count: usize,
+    /// Skip the exactness pass: return the natural count near N.
+    #[arg(long)]
+    pub(crate) expected: bool,
+    /// Write the same samples in tile order instead of progressive order
+    /// (skips the ranking sort; a prefix of the file is then not well spread).
+    #[arg(long)]
+    pub(crate) unsorted: bool,
+    /// Output file, `-` for standard output.
+    #[arg(short, long, default_value = "-")]
+    pub(crate) output: PathBuf,
+    /// Sample in a uniformly random frame drawn from this seed: a rotation
+    /// on the sphere, a toroidal shift on the plane. Estimates averaged
+    /// over seeds are unbiased; without it the output is deterministic.
+    #[arg(long)]
+    pub(crate) seed: Option<u64>,
+}
+
+impl RequestArgs {
+    /// The samples this request asks for from `system` under `density`.
+    pub(crate) fn generate<S, D>(
+        &self,
+        system: &S,
+        density: &D,
+    ) -> Result<Vec<Sample<S::Point>>, Error>
+    where
+        S: TileSystem,
+        S::Region: Region<Point = S::Point>,
+        D: Density<S::Region> + ?Sized,
+    {
+        let order = if self.unsorted {
+            Order::Unsorted
+        } else {
+            Order::Progressive
+        };
+        engine::generate_ordered(system, density, self.count, !self.expected, order)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum System {
+    Sphere,
+    /// Penrose (six tile types, Fibonacci codes) on the unit square.
+    Penrose,
+    /// G-hexomino, 81-rep, on the unit square.
+    Ghexomino,
+    /// P-pentomino, 4-rep, on the unit square.
+    Ppentomino,
+}
+
+impl System {
+    /// The planar table of a planar system.
+    pub(crate) fn plane(self) -> Option<tessera::lut::PlaneSystem> {
+        match self {
+            System::Sphere | System::Penrose => None,
+            System::Ghexomino => Some(tessera::lut::PlaneSystem::Ghexomino),
+            System::Ppentomino => Some(tessera::lut::PlaneSystem::Ppentomino),
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Domain {
+    /// Unit vectors `x y z`: separation, cap discrepancy, Riesz energy, covering radius.
+    Sphere,
+    /// Points `x y` in [0,1)^2: nearest-neighbour distances, discrepancies, spectrum.
+    Plane,
+}
+
+/// Uniform requests above this many samples stream one at a time (one
+/// thread, O(depth) memory) instead of being generated in parallel in memory.
+pub(crate) const STREAM_ABOVE: usize = 1 << 24;
+
+pub(crate) fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
+    if path == Path::new("-") {
+        return Ok(Box::new(std::io::BufWriter::new(std::io::stdout().lock())));
+    }
+    let file = std::fs::File::create(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    Ok(Box::new(std::io::BufWriter::new(file)))
+}
+
+pub(crate) fn io_error(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |source| Error::Io {
+        path: path.into(),
+        source,
+    }
+}
+
+/// The points of a file as unit vectors, refusing any that are not.
+pub(crate) fn read_sphere_points(path: &Path) -> Result<Vec<glam::DVec3>, Error> {
+    let rows = tessera::io::points::read_points(path, 3)?;
+    let points: Vec<glam::DVec3> = rows
+        .iter()
+        .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
+        .collect();
+    match points
+        .iter()
+        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
+    {
+        Some(bad) => Err(Error::File {
+            path: path.into(),
+            reason: format!("point {} is not a unit vector", bad + 1),
+        }),
+        None => Ok(points),
+    }
+}
+
+pub(crate) fn read_plane_points(path: &Path) -> Result<Vec<glam::DVec2>, Error> {
+    let rows = tessera::io::points::read_points(path, 2)?;
+    Ok(rows.iter().map(|r| glam::DVec2::new(r[0], r[1])).collect())
+}
+
+pub(crate) fn save_png<P, C>(img: &image::ImageBuffer<P, C>, path: &Path) -> Result<(), Error>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+{
+    img.save_with_format(path, image::ImageFormat::Png)
+        .map_err(|e| Error::File {
+            path: path.into(),
+            reason: format!("cannot write PNG: {e}"),
+        })
+}
+
+pub(crate) fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
+            .expect("static template"),
+    );
+    bar
+}

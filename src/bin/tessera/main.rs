@@ -1,0 +1,94 @@
+//! The `tessera` command line: a thin layer over the library.
+
+mod bench;
+mod common;
+mod lut;
+mod metrics;
+mod plane;
+mod plot;
+mod sphere;
+mod tiles;
+
+use bench::{bench_accuracy, BenchCommand};
+use clap::{Parser, Subcommand};
+use lut::{lut_build, lut_tiling, LutCommand};
+use metrics::{metrics, MetricsArgs};
+use plane::{plane, PlaneArgs};
+use plot::{plot, PlotArgs};
+use sphere::{sphere, SphereArgs};
+use std::process::ExitCode;
+use tiles::{tiles, TilesArgs};
+
+#[derive(Parser)]
+#[command(
+    name = "tessera",
+    version,
+    about = "Blue-noise importance sampling with self-similar tilings"
+)]
+struct Cli {
+    /// Worker threads (default: all cores). The output does not depend on it.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Sample the unit sphere (HEALPix faces tiled by P-pentominoes).
+    Sphere(SphereArgs),
+    /// Sample the unit square (Penrose, G-hexomino or P-pentomino tilings).
+    Plane(PlaneArgs),
+    /// Draw a tiling level and its samples as SVG.
+    Tiles(TilesArgs),
+    /// Build the offline tables in luts/.
+    Lut {
+        #[command(subcommand)]
+        command: LutCommand,
+    },
+    /// Quality measures of a point file (text formats tessera writes, or UTK binary).
+    Metrics(MetricsArgs),
+    /// Render a point file as a PNG picture.
+    Plot(PlotArgs),
+    /// Measurements: `bench accuracy` writes ACCURACY.md and its plots.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(threads) = cli.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build_global()
+        {
+            eprintln!("tessera: cannot start {threads} threads: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let result = match cli.command {
+        Command::Sphere(args) => sphere(args),
+        Command::Plane(args) => plane(args),
+        Command::Tiles(args) => tiles(args),
+        Command::Lut {
+            command: LutCommand::Build(args),
+        } => lut_build(args),
+        Command::Lut {
+            command: LutCommand::Tiling(args),
+        } => lut_tiling(args),
+        Command::Metrics(args) => metrics(args),
+        Command::Plot(args) => plot(args),
+        Command::Bench {
+            command: BenchCommand::Accuracy(args),
+        } => bench_accuracy(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("tessera: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
