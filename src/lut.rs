@@ -11,10 +11,25 @@ use std::sync::{Arc, OnceLock};
 
 /// Pentominoes per sphere face at level 0: a sphere table holds a rule for
 /// each of a face's roots.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::lut::ROOTS_PER_FACE * 5, 10 * 10); // a 10x10 patch
+/// ```
 pub const ROOTS_PER_FACE: usize = 20;
 /// Number of level-0 tiles on the sphere.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::lut::ROOT_COUNT, 240);
+/// ```
 pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 /// Most cells a planar rep-tile of a table may have.
+///
+/// # Example
+/// ```
+/// assert!(tessera::polyomino::Shape::g_hexomino().cells().len() <= tessera::lut::MAX_CELLS);
+/// ```
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.

@@ -167,9 +167,27 @@ impl Raster {
 impl Raster {
     /// A negative pixel within this fraction of the brightest pixel two
     /// pixels around it is codec ringing ([`Raster::from_values`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::io::image::Raster;
+    /// // ringing beside a bright pixel passes --strict
+    /// let v = vec![1.0, 1.0, 100.0, -4.0, 1.0, 1.0];
+    /// assert!(Raster::from_values("mem", 6, 1, v, true).is_ok());
+    /// assert!(Raster::NOISE_NEIGHBOURHOOD * 100.0 >= 4.0);
+    /// ```
     pub const NOISE_NEIGHBOURHOOD: f64 = 0.05;
     /// A negative pixel within this fraction of the median positive pixel
     /// is codec noise around zero ([`Raster::from_values`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::io::image::Raster;
+    /// // far from bright pixels, half the median is damage
+    /// let v = vec![1.0, 1.0, 1.0, 1.0, 1.0, -0.5, 1.0, 1.0];
+    /// assert!(Raster::from_values("mem", 8, 1, v, true).is_err());
+    /// assert!(Raster::NOISE_MEDIAN < 0.5);
+    /// ```
     pub const NOISE_MEDIAN: f64 = 0.01;
 }
 
