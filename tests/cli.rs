@@ -353,3 +353,52 @@ fn point_files_are_refused_with_the_reason_or_read_whatever_tessera_wrote() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn seeds_randomise_every_density_and_the_plane_writes_pdfs() {
+    let run = |args: &[&str]| {
+        let out = tessera(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let cap = ["sphere", "-n", "300", "--density", "cap:0,90,20,10"];
+    let with = |seed: &str| run(&[&cap[..], &["--seed", seed]].concat());
+    assert_eq!(with("1"), with("1"));
+    assert_ne!(with("1"), with("2"));
+    assert_ne!(with("1"), run(&cap));
+    // a seeded cap still follows the cap: it holds 23.7 % of the mass
+    // (solid angle 2 pi (1 - cos 20 deg), contrast 10), 71 of 300 points
+    let inside = with("4")
+        .lines()
+        .filter(|l| l.split(' ').nth(2).unwrap().parse::<f64>().unwrap() > 20f64.to_radians().cos())
+        .count();
+    assert!((56..=86).contains(&inside), "{inside}");
+    let plane = [
+        "plane",
+        "--system",
+        "ppentomino",
+        "-n",
+        "400",
+        "--density",
+        "ramp",
+    ];
+    let csv = run(&[&plane[..], &["--seed", "3", "--format", "csv"]].concat());
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,y,pdf"));
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        // the ramp's pdf per unit area is 2x
+        assert!(
+            (v[2] - 2.0 * v[0]).abs() < 1e-9 && (0.0..1.0).contains(&v[1]),
+            "{line}"
+        );
+    }
+    assert_ne!(
+        run(&[&plane[..], &["--seed", "3"]].concat()),
+        run(&[&plane[..], &["--seed", "4"]].concat())
+    );
+}

@@ -69,34 +69,53 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
     let density = tessera::density::region::parse_all(&args.density)?;
     let tiling = SphereTiling::default();
     let pdf = |p| engine::pdf(&tiling, &*density, p);
-    if let Some(seed) = args.request.seed {
-        return sphere_rotated(&args, &Rotated::new(&*density, seed), format, pdf);
-    }
-    let window = args.within.as_deref().map(Cap::window).transpose()?;
+    let Some(window) = args.within.as_deref().map(Cap::window).transpose()? else {
+        return match args.request.seed {
+            Some(seed) => {
+                let rotated = Rotated::new(&*density, seed);
+                write_samples(&args, &rotated, |p| rotated.to_world(p), format, pdf)
+            }
+            None => write_samples(&args, &*density, |p| p, format, pdf),
+        };
+    };
+    // a window visits only the tiles reaching it
+    let near = engine::collect_within(&tiling, &*density, args.request.count as f64, &|r| {
+        window.reaches(r)
+    });
+    let inside = near
+        .iter()
+        .map(|s| s.position)
+        .filter(|&p| window.contains(p));
+    let points: Vec<glam::DVec3> = inside.collect();
+    let mut out = create(&args.request.output)?;
+    tessera::io::points::write_sphere(&mut out, points, format, pdf)
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.request.output))
+}
+
+/// The samples of `density` (in its sampling frame, which `to_world` maps
+/// to the world) written as `format`; large uniform requests stream in
+/// O(depth) memory.
+fn write_samples<D>(
+    args: &SphereArgs,
+    density: &D,
+    to_world: impl Fn(glam::DVec3) -> glam::DVec3,
+    format: SphereFormat,
+    pdf: impl Fn(glam::DVec3) -> f64,
+) -> Result<(), Error>
+where
+    D: Density<SphereRegion> + ?Sized,
+{
+    let tiling = SphereTiling::default();
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(&tiling, args.request.count) {
-        // a window visits only the tiles reaching it
-        _ if window.is_some() => {
-            let window = window.expect("a window");
-            let near =
-                engine::collect_within(&tiling, &*density, args.request.count as f64, &|r| {
-                    window.reaches(r)
-                });
-            let inside = near
-                .iter()
-                .map(|s| s.position)
-                .filter(|&p| window.contains(p));
-            let points: Vec<glam::DVec3> = inside.collect();
-            tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        }
-        // large uniform requests stream: memory stays O(depth)
         Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
-            let points = stream.map(|s| s.position);
+            let points = stream.map(|s| to_world(s.position));
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
         _ => {
-            let samples = args.request.generate(&tiling, &*density)?;
-            let points: Vec<glam::DVec3> = samples.iter().map(|s| s.position).collect();
+            let samples = args.request.generate(&tiling, density)?;
+            let points: Vec<glam::DVec3> = samples.iter().map(|s| to_world(s.position)).collect();
             if args.report {
                 print_report(&points);
             }
@@ -154,37 +173,6 @@ pub(crate) fn sphere_map(
     }
     let mut out = create(&args.request.output)?;
     tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
-        .and_then(|()| out.flush())
-        .map_err(io_error(&args.request.output))
-}
-
-/// `sphere` with `--seed`: the density sampled in a random rotated frame.
-pub(crate) fn sphere_rotated(
-    args: &SphereArgs,
-    density: &Rotated<&(dyn Density<SphereRegion> + Send)>,
-    format: SphereFormat,
-    pdf: impl Fn(glam::DVec3) -> f64,
-) -> Result<(), Error> {
-    let tiling = SphereTiling::default();
-    let mut out = create(&args.request.output)?;
-    let written = match engine::stream(&tiling, args.request.count) {
-        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
-            let points = stream.map(|s| density.to_world(s.position));
-            tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        }
-        _ => {
-            let samples = args.request.generate(&tiling, density)?;
-            let points: Vec<glam::DVec3> = samples
-                .iter()
-                .map(|s| density.to_world(s.position))
-                .collect();
-            if args.report {
-                print_report(&points);
-            }
-            tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        }
-    };
-    written
         .and_then(|()| out.flush())
         .map_err(io_error(&args.request.output))
 }
