@@ -13,6 +13,7 @@
 
 pub mod cdf;
 pub mod envmap;
+pub mod median_cut;
 pub mod sobol;
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
