@@ -2,8 +2,9 @@
 //! classic and greedy median cut at the same N, on the realistic generated
 //! maps, each also rotated (resampled) by three fixed rotations.
 //!
-//!     cargo run --release --example lights -- [--write] [--sweep] [--quick]
-//!         [--exponent E] [--lloyd K] [--tolerance T]
+//!     cargo run --release --example lights -- [--write] [--sweep] [--held-out]
+//!         [--quick] [--no-tables] [--exponent E] [--cap C] [--lloyd K]
+//!         [--tolerance T] [--configs E:C,...] [--steps K,...] [--counts N,...]
 //!
 //! For each map (clear sky, overcast, city at night, interior; 1024 x 512,
 //! seed 1) and each frame, the reference integrals are computed by
@@ -15,10 +16,13 @@
 //! around 64 fixed random axes. A set of lights gives `sum_k P_k f(w_k)`;
 //! the error is the relative RMSE over the normals (axes).
 //!
-//! `--sweep` adds the measurements behind the default density exponent
-//! and Lloyd steps; `--write` writes docs/LIGHTS.md and docs/img/lights.png
-//! (with `--sweep`, the full document); `--quick` runs only the unrotated
-//! maps.
+//! `--sweep` adds the measurements behind the default density exponent,
+//! pixel cap and Lloyd steps (`--configs`, `--steps`, `--counts` narrow it)
+//! and the accuracy of the cells; `--held-out` repeats the summary on the
+//! maps of seed 2; `--write` writes docs/LIGHTS.md and docs/img/lights.png
+//! (`--write --sweep --held-out` is the full document); `--quick` runs only
+//! the unrotated maps; `--exponent`, `--cap`, `--lloyd`, `--tolerance`
+//! override tessera's defaults in the tables.
 
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -250,7 +254,8 @@ struct Args {
     sweep: bool,
     quick: bool,
     no_tables: bool,
-    configs: Option<Vec<(f64, f64)>>,
+    held_out: bool,
+    configs: Option<Vec<(Option<f64>, f64)>>,
     steps: Option<Vec<usize>>,
     counts: Option<Vec<usize>>,
     options: LightOptions<'static>,
@@ -262,6 +267,7 @@ fn args() -> Args {
         sweep: false,
         quick: false,
         no_tables: false,
+        held_out: false,
         configs: None,
         steps: None,
         counts: None,
@@ -279,14 +285,16 @@ fn args() -> Args {
             "--sweep" => a.sweep = true,
             "--quick" => a.quick = true,
             "--no-tables" => a.no_tables = true,
+            "--held-out" => a.held_out = true,
             "--configs" => {
-                // EXPONENT:CAP,EXPONENT:CAP,...
+                // EXPONENT:CAP,EXPONENT:CAP,... (EXPONENT `auto`: the rule of N)
                 let list = it.next().expect("--configs needs a list");
                 a.configs = Some(
                     list.split(',')
                         .map(|c| {
                             let (e, cap) = c.split_once(':').expect("EXPONENT:CAP");
-                            (e.parse().expect("exponent"), cap.parse().expect("cap"))
+                            let e = (e != "auto").then(|| e.parse().expect("exponent"));
+                            (e, cap.parse().expect("cap"))
                         })
                         .collect(),
                 );
@@ -328,22 +336,7 @@ fn main() {
     if args.quick {
         frames.truncate(1);
     }
-    let mut cases = Vec::new();
-    for sky in SKIES {
-        let base = sky.generate(W, H, 1);
-        for &(frame, rotation) in &frames {
-            let rgb = RgbMap::from(rotate(&base, rotation));
-            let map = rgb.env_map(Default::default()).expect("a lit map");
-            let reference = reference(&map, &probes);
-            cases.push(Case {
-                sky,
-                frame,
-                rgb,
-                map,
-                reference,
-            });
-        }
-    }
+    let cases = build_cases(1, &frames, &probes);
     eprintln!(
         "maps and references: {:.1} s",
         started.elapsed().as_secs_f64()
@@ -355,6 +348,7 @@ fn main() {
             (" --write", args.write),
             (" --sweep", args.sweep),
             (" --quick", args.quick),
+            (" --held-out", args.held_out),
         ] {
             if on {
                 c.push_str(flag);
@@ -387,7 +381,22 @@ fn main() {
         quadrature(&cases, &mut doc);
     }
     if !args.no_tables {
-        tables(&cases, &probes, &args.options, &mut doc);
+        tables(&cases, &probes, &args.options, "Summary", true, &mut doc);
+    }
+    if args.held_out {
+        let held = build_cases(2, &frames, &probes);
+        let _ = writeln!(
+            doc,
+            "\n# Held out: the same maps generated from seed 2\n\nThe defaults were chosen on the seed-1 maps above; the same comparison on the maps of seed 2 (another sun position, other lights, lamps and texture), in the same frames:\n"
+        );
+        tables(
+            &held,
+            &probes,
+            &args.options,
+            "Held-out summary",
+            false,
+            &mut doc,
+        );
     }
     let _ = writeln!(
         doc,
@@ -402,8 +411,37 @@ fn main() {
     }
 }
 
-/// The error tables at the given options, and the floors.
-fn tables(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut String) {
+/// The maps of `seed` in every frame, with their references.
+fn build_cases(seed: u64, frames: &[(&'static str, DMat3)], probes: &Probes) -> Vec<Case> {
+    let mut cases = Vec::new();
+    for sky in SKIES {
+        let base = sky.generate(W, H, seed);
+        for &(frame, rotation) in frames {
+            let rgb = RgbMap::from(rotate(&base, rotation));
+            let map = rgb.env_map(Default::default()).expect("a lit map");
+            let reference = reference(&map, probes);
+            cases.push(Case {
+                sky,
+                frame,
+                rgb,
+                map,
+                reference,
+            });
+        }
+    }
+    cases
+}
+
+/// The error tables at the given options, and the floors: a summary of
+/// ratios, and with `full` every error.
+fn tables(
+    cases: &[Case],
+    probes: &Probes,
+    options: &LightOptions,
+    title: &str,
+    full: bool,
+    doc: &mut String,
+) {
     let metrics = ["diffuse", "glossy m = 10", "glossy m = 100"];
     // results[case][n] = [method][metric]
     let results: Vec<Vec<[[f64; 3]; 3]>> = cases
@@ -422,7 +460,7 @@ fn tables(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
     // summary and floors
     let _ = writeln!(
         doc,
-        "## Summary: tessera's error / the better median cut's\n"
+        "## {title}: tessera's error / the better median cut's\n"
     );
     let _ = writeln!(
         doc,
@@ -456,11 +494,10 @@ fn tables(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
                     ratio(e, 0)
                 ));
             }
-            for m in 1..3 {
+            for (m, metric) in metrics.iter().enumerate().skip(1) {
                 if ratio(e, m) >= 1.0 {
                     misses.push(format!(
-                        "{} on {} at N = {n}: {:.3}x",
-                        metrics[m],
+                        "{metric} on {} at N = {n}: {:.3}x",
                         case.label(),
                         ratio(e, m)
                     ));
@@ -494,7 +531,9 @@ fn tables(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
     for m in &misses {
         let _ = writeln!(doc, "- missed: {m}");
     }
-    // full tables
+    if !full {
+        return;
+    }
     let _ = writeln!(doc, "\n## Full tables: relative RMSE\n");
     let _ = writeln!(
         doc,
@@ -529,21 +568,24 @@ fn tables(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
 fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     let inf = f64::INFINITY;
     let default_configs = [
-        (0.5, inf),
-        (0.625, inf),
-        (0.75, inf),
-        (0.875, inf),
-        (1.0, inf),
-        (0.75, 4.0),
-        (0.875, 4.0),
-        (1.0, 4.0),
-        (0.75, 1.0),
-        (0.875, 1.0),
-        (1.0, 1.0),
+        (Some(0.5), inf),
+        (Some(0.75), inf),
+        (Some(0.875), inf),
+        (Some(1.0), inf),
+        (Some(0.625), 1.0),
+        (Some(0.75), 1.0),
+        (Some(0.875), 1.0),
+        (Some(0.95), 1.0),
+        (Some(1.0), 1.0),
+        (Some(0.875), 4.0),
+        (None, 1.0),
     ];
     let configs = args.configs.clone().unwrap_or(default_configs.to_vec());
     let steps = args.steps.clone().unwrap_or(vec![0usize, 1, 2, 3]);
-    let counts = args.counts.clone().unwrap_or(vec![256usize, 1024, 4096]);
+    let counts = args
+        .counts
+        .clone()
+        .unwrap_or(vec![64usize, 256, 1024, 4096]);
     // the better median cut's errors, per case and N
     let best: Vec<Vec<[f64; 3]>> = cases
         .iter()
@@ -572,11 +614,12 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     );
     let _ = writeln!(doc, "| exponent | pixel cap | Lloyd steps | diffuse | glossy 10 | glossy 100 | misses | mean time (ms) |");
     let _ = writeln!(doc, "|---:|---:|---:|---:|---:|---:|---:|---:|");
-    let mut per_n: Vec<(f64, f64, usize, Vec<[f64; 3]>)> = Vec::new();
+    let mut per_n: Vec<(String, f64, usize, Vec<[f64; 3]>)> = Vec::new();
     for &(e, cap) in &configs {
         for &k in &steps {
+            let name = e.map_or("per N".to_string(), |e| e.to_string());
             let options = LightOptions {
-                exponent: Some(e),
+                exponent: e,
                 pixel_cap: cap,
                 lloyd_steps: k,
                 ..Default::default()
@@ -605,7 +648,7 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
                         if (m == 0 && r > 1.0 && floor_n) || (m > 0 && r >= 1.0) {
                             misses += 1;
                             eprintln!(
-                                "  miss: exponent {e} cap {cap} Lloyd {k}: metric {m} on {} at N = {n}: {r:.3}",
+                                "  miss: exponent {name} cap {cap} Lloyd {k}: metric {m} on {} at N = {n}: {r:.3}",
                                 case.label()
                             );
                         }
@@ -615,7 +658,7 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
             let cells = (cases.len() * counts.len()) as f64;
             let _ = writeln!(
                 doc,
-                "| {e} | {cap} | {k} | {:.3} ({:.2}) | {:.3} ({:.2}) | {:.3} ({:.2}) | {misses} | {:.0} |",
+                "| {name} | {cap} | {k} | {:.3} ({:.2}) | {:.3} ({:.2}) | {:.3} ({:.2}) | {misses} | {:.0} |",
                 (logs[0] / cells).exp(),
                 worst[0],
                 (logs[1] / cells).exp(),
@@ -624,8 +667,8 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
                 worst[2],
                 time / cells * 1e3
             );
-            per_n.push((e, cap, k, by_n));
-            eprintln!("sweep exponent {e} cap {cap} Lloyd {k} done");
+            eprintln!("sweep exponent {name} cap {cap} Lloyd {k} done");
+            per_n.push((name, cap, k, by_n));
         }
     }
     let _ = writeln!(

@@ -242,8 +242,8 @@ struct LightsArgs {
     /// Draw the directions in a random frame from this seed.
     #[arg(long)]
     seed: Option<u64>,
-    /// Density exponent: directions follow value^EXPONENT (default: a
-    /// rule of N, 0.875 up to N = 1024 rising to 0.95 at N = 4096).
+    /// Density exponent: directions follow value^EXPONENT (default: a rule
+    /// of N, 0.625 at N <= 64, 0.875 at 256-1024, 0.95 from 4096).
     #[arg(long)]
     exponent: Option<f64>,
     /// Lloyd steps after the first cut (each one more pass over the map).

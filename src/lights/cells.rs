@@ -509,9 +509,7 @@ impl Ctx<'_, '_> {
                 clip_shares(
                     points,
                     &s.arena[start..start + len],
-                    node.rect,
-                    node.theta,
-                    node.cs,
+                    &node,
                     &mut shares,
                     &mut s.polygons,
                     &mut s.lin,
@@ -571,15 +569,15 @@ impl Ctx<'_, '_> {
 fn clip_shares(
     points: &[DVec3],
     cands: &[u32],
-    rect: [f64; 4],
-    [t0, t1]: [f64; 2],
-    [cs, sn]: [f64; 2],
+    node: &Node,
     out: &mut Vec<(u32, f64, DVec3)>,
     polygons: &mut [Vec<[f64; 2]>; 2],
     lin: &mut Vec<[f64; 3]>,
 ) {
     out.clear();
-    let [p0, p1, _, _] = rect;
+    let [p0, p1, _, _] = node.rect;
+    let [t0, t1] = node.theta;
+    let [cs, sn] = node.cs;
     let tc = (t0 + t1) / 2.0;
     let (hp, ht) = ((p1 - p0) / 2.0, (t1 - t0) / 2.0);
     let (st, ct) = tc.sin_cos();

@@ -197,10 +197,12 @@ pub(super) fn read_rgb(path: &Path, options: &ReadOptions) -> Result<(RgbMap, Ra
     let planes: [&Channel; 3] = match (rgb_channels, grey.or(wanted)) {
         (Some(rgb), _) => rgb,
         (None, Some(c)) => [c, c, c],
-        (None, None) => return Err(fail(format!(
+        (None, None) => {
+            return Err(fail(format!(
             "no R, G, B or Y channels for luminance (the file has: {}); pick one with --channel",
             names()
-        ))),
+        )))
+        }
     };
     let values: Vec<f64> = match (wanted, rgb_channels) {
         (Some(c), _) => c.samples.iter().map(|&v| decode(v)).collect(),
