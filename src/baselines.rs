@@ -13,6 +13,7 @@
 
 pub mod cdf;
 pub mod envmap;
+pub mod median_cut;
 pub mod sobol;
 
 pub use crate::random::{random_rotation, SplitMix64};

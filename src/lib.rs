@@ -20,6 +20,7 @@ pub mod engine;
 mod error;
 pub mod healpix;
 pub mod io;
+pub mod lights;
 pub mod lut;
 mod memory;
 pub mod metrics;

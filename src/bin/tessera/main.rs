@@ -2,6 +2,7 @@
 
 mod bench;
 mod common;
+mod lights;
 mod lut;
 mod metrics;
 mod plane;
@@ -11,6 +12,7 @@ mod tiles;
 
 use bench::{bench_accuracy, BenchCommand};
 use clap::{Parser, Subcommand};
+use lights::{lights, LightsArgs};
 use lut::{lut_build, lut_tiling, LutCommand};
 use metrics::{metrics, MetricsArgs};
 use plane::{plane, PlaneArgs};
@@ -50,6 +52,8 @@ enum Command {
     Metrics(MetricsArgs),
     /// Render a point file as a PNG picture.
     Plot(PlotArgs),
+    /// Turn a lat-long environment map into N directional lights with exact powers.
+    Lights(LightsArgs),
     /// Measurements: `bench accuracy` writes ACCURACY.md and its plots.
     Bench {
         #[command(subcommand)]
@@ -80,6 +84,7 @@ fn main() -> ExitCode {
         } => lut_tiling(args),
         Command::Metrics(args) => metrics(args),
         Command::Plot(args) => plot(args),
+        Command::Lights(args) => lights(args),
         Command::Bench {
             command: BenchCommand::Accuracy(args),
         } => bench_accuracy(args),

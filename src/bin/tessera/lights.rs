@@ -1,0 +1,97 @@
+//! `tessera lights`: an environment map turned into N directional lights.
+
+use crate::common::*;
+use crate::sphere::UpAxis;
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+use tessera::Error;
+
+#[derive(Args)]
+pub(crate) struct LightsArgs {
+    /// The lat-long map (OpenEXR, Radiance .hdr or PNG).
+    #[arg(long)]
+    map: PathBuf,
+    /// Number of lights (exactly this many).
+    #[arg(short = 'n', long = "count")]
+    count: usize,
+    /// Output file, `-` for standard output.
+    #[arg(short, long, default_value = "-")]
+    output: PathBuf,
+    /// csv: header `x,y,z,r,g,b,luminance,solid_angle`, one light per line;
+    /// json: an array of objects with those keys.
+    #[arg(long, default_value = "csv", value_parser = ["csv", "json"])]
+    format: String,
+    /// Draw the directions from this map channel (e.g. R, Y) instead of
+    /// Rec.709 luminance; the `luminance` column is then its power.
+    #[arg(long)]
+    channel: Option<String>,
+    /// The map's up axis, as for `sphere --map`.
+    #[arg(long, value_enum, default_value = "z")]
+    up: UpAxis,
+    /// Refuse maps with negative, NaN or infinite samples.
+    #[arg(long)]
+    strict: bool,
+    /// Draw the directions in a random frame from this seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Density exponent: directions follow value^EXPONENT (default: a rule
+    /// of N, 0.625 at N <= 64, 0.875 at 256-1024, 0.95 from 4096).
+    #[arg(long)]
+    exponent: Option<f64>,
+    /// Lloyd steps after the first cut (each one more pass over the map).
+    #[arg(long, default_value_t = tessera::lights::DEFAULT_LLOYD_STEPS)]
+    lloyd: usize,
+}
+
+/// `lights`: read the map's colour and importance in one decode, warn and
+/// refuse as `sphere --map` does, write the lights.
+pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
+    use tessera::density::envmap::{EnvMap, Up};
+    use tessera::lights::{read_rgb, LightOptions};
+    let path = &args.map;
+    let options = tessera::io::image::ReadOptions {
+        channel: args.channel.clone(),
+        strict: args.strict,
+        ..Default::default()
+    };
+    let (rgb, raster) = read_rgb(path, &options)?;
+    let name = path.display();
+    if raster.bad_pixels > 0 || rgb.bad_samples > 0 {
+        eprintln!(
+            "tessera: warning: {name}: {} pixel(s) and {} colour sample(s) negative, NaN or infinite, treated as 0 (--strict refuses them)",
+            raster.bad_pixels, rgb.bad_samples
+        );
+    }
+    if raster.width != 2 * raster.height {
+        eprintln!(
+            "tessera: warning: {name}: {}x{} is not a 2:1 lat-long map; using it as one",
+            raster.width, raster.height
+        );
+    }
+    let up = match args.up {
+        UpAxis::Z => Up::Z,
+        UpAxis::Y => Up::Y,
+    };
+    let map = EnvMap::new(raster, up).map_err(|e| Error::File {
+        path: path.into(),
+        reason: e.to_string(),
+    })?;
+    let options = LightOptions {
+        rgb: Some(&rgb),
+        exponent: args.exponent,
+        lloyd_steps: args.lloyd,
+        seed: args.seed,
+        ..Default::default()
+    };
+    let lights = tessera::lights::lights(&map, args.count, &options)?;
+    let mut out = create(&args.output)?;
+    let written = if args.format == "json" {
+        tessera::lights::write_json(&mut out, &lights)
+    } else {
+        tessera::lights::write_csv(&mut out, &lights)
+    };
+    written
+        .and_then(|()| out.flush())
+        .map_err(io_error(&args.output))
+}
