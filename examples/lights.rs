@@ -376,6 +376,12 @@ fn main() {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     let _ = writeln!(doc, "{METHOD}");
+    if args.write {
+        let _ = writeln!(
+            doc,
+            "![lights over the maps](img/lights.png)\n\n*The clear sky (top) and the interior (bottom) at N = 256: tessera's lights (left, red) and greedy median cut's (right, blue) over the map (equirectangular, tone-mapped), dot area in proportion to the light's power (radius capped at 10 pixels, which only the sun's light reaches).*\n"
+        );
+    }
     if args.sweep {
         sweep(&cases, &probes, &args, &mut doc);
         quadrature(&cases, &mut doc);
@@ -383,6 +389,7 @@ fn main() {
     if !args.no_tables {
         tables(&cases, &probes, &args.options, "Summary", true, &mut doc);
     }
+    bench_times(&mut doc);
     if args.held_out {
         let held = build_cases(2, &frames, &probes);
         let _ = writeln!(
@@ -564,6 +571,56 @@ fn tables(
     }
 }
 
+/// The single-thread times of `cargo bench --bench lights`, read from
+/// criterion's saved estimates when that bench has been run.
+fn bench_times(doc: &mut String) {
+    let dir = std::path::Path::new("target/criterion/lights_1024x512_n4096_1_thread");
+    let names = [
+        ("load_only", "reading the EXR (colour and importance) only"),
+        ("tessera_lloyd_0", "tessera, 0 Lloyd steps"),
+        ("tessera_lloyd_1", "tessera, 1 Lloyd step"),
+        ("tessera_lloyd_2", "tessera, 2 Lloyd steps"),
+        ("tessera_lloyd_3_default", "tessera, 3 Lloyd steps (the default)"),
+        ("median_cut_classic", "classic median cut"),
+        ("median_cut_greedy", "greedy median cut"),
+    ];
+    let mut rows = Vec::new();
+    for (name, what) in names {
+        let path = dir.join(name).join("new/estimates.json");
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+            continue;
+        };
+        let median = &v["median"];
+        if let (Some(m), Some(lo), Some(hi)) = (
+            median["point_estimate"].as_f64(),
+            median["confidence_interval"]["lower_bound"].as_f64(),
+            median["confidence_interval"]["upper_bound"].as_f64(),
+        ) {
+            rows.push(format!(
+                "| {what} | {:.0} | {:.0} - {:.0} |",
+                m / 1e6,
+                lo / 1e6,
+                hi / 1e6
+            ));
+        }
+    }
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(doc, "\n## Time\n");
+    let _ = writeln!(
+        doc,
+        "From `cargo bench --bench lights` (criterion's saved estimates, read by this example): the 1024 x 512 clear-sky map as an f32 EXR, N = 4096, one thread, reading the file included. The issue's floor is 0.5 s.\n"
+    );
+    let _ = writeln!(doc, "| what | median (ms) | 95 % interval (ms) |\n|---|---:|---:|");
+    for r in rows {
+        let _ = writeln!(doc, "{r}");
+    }
+}
+
 /// The measurements behind the default exponent, pixel cap and Lloyd steps.
 fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     let inf = f64::INFINITY;
@@ -742,8 +799,10 @@ fn quadrature(cases: &[Case], doc: &mut String) {
     let _ = writeln!(doc);
 }
 
-/// docs/img/lights.png: the clear sky and the interior at N = 256, tessera
-/// (left) and greedy median cut (right), dot area by luminance power.
+/// docs/img/lights.png: the clear sky (top) and the interior (bottom) at
+/// N = 256, tessera (left, red) and greedy median cut (right, blue), dot
+/// area by luminance power (capped at a 10-pixel radius: the sun's light),
+/// at half the maps' resolution.
 fn picture(cases: &[Case], options: &LightOptions, path: &str) {
     let n = 256;
     let picked: Vec<&Case> = [Sky::ClearSky, Sky::Interior]
@@ -754,7 +813,8 @@ fn picture(cases: &[Case], options: &LightOptions, path: &str) {
                 .find(|c| c.sky == s && c.frame == "as generated")
         })
         .collect();
-    let (pw, ph) = (W, H);
+    // panels at half the map's resolution, each pixel the mean of 2 x 2
+    let (pw, ph) = (W / 2, H / 2);
     let mut img = image::RgbImage::new(2 * pw as u32, (ph * picked.len()) as u32);
     for (row, case) in picked.iter().enumerate() {
         let options = LightOptions {
@@ -770,17 +830,26 @@ fn picture(cases: &[Case], options: &LightOptions, path: &str) {
             let (x0, y0) = (col * pw, row * ph);
             for j in 0..ph {
                 for i in 0..pw {
-                    let p = case.rgb.rgb[j * pw + i];
-                    let l = case.map.values()[j * pw + i];
+                    let (mut p, mut l) = ([0.0f64; 3], 0.0);
+                    for (a, b) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let q = (2 * j + b) * W + 2 * i + a;
+                        for (c, v) in p.iter_mut().zip(case.rgb.rgb[q]) {
+                            *c += v as f64 / 4.0;
+                        }
+                        l += case.map.values()[q] / 4.0;
+                    }
                     let scale = if l > 0.0 { (l / (l + key)) / l } else { 0.0 };
                     let px = p.map(|c| {
-                        let v = (c as f64 * scale).clamp(0.0, 1.0).powf(1.0 / 2.2);
+                        let v = (c * scale).clamp(0.0, 1.0).powf(1.0 / 2.2);
                         (v * 200.0) as u8
                     });
                     img.put_pixel((x0 + i) as u32, (y0 + j) as u32, image::Rgb(px));
                 }
             }
-            let top = set.iter().map(|l| l.luminance).fold(0.0, f64::max);
+            // dot area in proportion to power: all dots together would
+            // cover 6 % of the panel; radii capped at 10 pixels
+            let total: f64 = set.iter().map(|l| l.luminance).sum();
+            let per_power = 0.06 * (pw * ph) as f64 / total;
             let colour = if col == 0 {
                 [255, 60, 40]
             } else {
@@ -792,7 +861,7 @@ fn picture(cases: &[Case], options: &LightOptions, path: &str) {
                 let d = l.direction;
                 let x = d.y.atan2(d.x).rem_euclid(TAU) / TAU * pw as f64;
                 let y = d.z.clamp(-1.0, 1.0).acos() / PI * ph as f64;
-                let r = (28.0 * (l.luminance / top).sqrt()).max(1.5);
+                let r = (l.luminance * per_power / PI).sqrt().clamp(0.8, 10.0);
                 let reach = r.ceil() as i64 + 1;
                 for dy in -reach..=reach {
                     for dx in -reach..=reach {
