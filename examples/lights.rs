@@ -580,7 +580,10 @@ fn bench_times(doc: &mut String) {
         ("tessera_lloyd_0", "tessera, 0 Lloyd steps"),
         ("tessera_lloyd_1", "tessera, 1 Lloyd step"),
         ("tessera_lloyd_2", "tessera, 2 Lloyd steps"),
-        ("tessera_lloyd_3_default", "tessera, 3 Lloyd steps (the default)"),
+        (
+            "tessera_lloyd_3_default",
+            "tessera, 3 Lloyd steps (the default)",
+        ),
         ("median_cut_classic", "classic median cut"),
         ("median_cut_greedy", "greedy median cut"),
     ];
@@ -615,7 +618,10 @@ fn bench_times(doc: &mut String) {
         doc,
         "From `cargo bench --bench lights` (criterion's saved estimates, read by this example): the 1024 x 512 clear-sky map as an f32 EXR, N = 4096, one thread, reading the file included. The issue's floor is 0.5 s.\n"
     );
-    let _ = writeln!(doc, "| what | median (ms) | 95 % interval (ms) |\n|---|---:|---:|");
+    let _ = writeln!(
+        doc,
+        "| what | median (ms) | 95 % interval (ms) |\n|---|---:|---:|"
+    );
     for r in rows {
         let _ = writeln!(doc, "{r}");
     }
