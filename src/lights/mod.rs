@@ -24,8 +24,8 @@
 //! decided, so every light drawn where the map is positive gets positive
 //! power, and Lloyd steps keep every generator on a lit pixel. On the
 //! 1024 x 512 test maps at the default tolerance, light powers are within
-//! about 6e-5 (relative) of the exact Voronoi cells' and directions within
-//! 5e-5 rad (docs/LIGHTS.md). A k-d tree (kiddo) finds each block of
+//! about 7e-5 (relative) of the exact Voronoi cells' and directions within
+//! 6e-5 rad (docs/LIGHTS.md). A k-d tree (kiddo) finds each block of
 //! pixels' few candidate lights; a pass is `O(pixels log N)` plus the
 //! boundary pieces, runs in parallel with rayon, and its result does not
 //! depend on the thread count. Passes before the last (the Lloyd steps)
