@@ -47,7 +47,6 @@ pub(crate) struct LightsArgs {
 /// `lights`: read the map's colour and importance in one decode, warn and
 /// refuse as `sphere --map` does, write the lights.
 pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
-    use tessera::density::envmap::{EnvMap, Up};
     use tessera::lights::{read_rgb, LightOptions};
     let path = &args.map;
     let options = tessera::io::image::ReadOptions {
@@ -63,20 +62,7 @@ pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
             raster.bad_pixels, rgb.bad_samples
         );
     }
-    if raster.width != 2 * raster.height {
-        eprintln!(
-            "tessera: warning: {name}: {}x{} is not a 2:1 lat-long map; using it as one",
-            raster.width, raster.height
-        );
-    }
-    let up = match args.up {
-        UpAxis::Z => Up::Z,
-        UpAxis::Y => Up::Y,
-    };
-    let map = EnvMap::new(raster, up).map_err(|e| Error::File {
-        path: path.into(),
-        reason: e.to_string(),
-    })?;
+    let map = crate::sphere::env_map(path, raster, args.up)?;
     let options = LightOptions {
         rgb: Some(&rgb),
         exponent: args.exponent,

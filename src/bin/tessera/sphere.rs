@@ -132,7 +132,6 @@ pub(crate) fn sphere_map(
     path: &Path,
     format: SphereFormat,
 ) -> Result<(), Error> {
-    use tessera::density::envmap::{EnvMap, Up};
     let options = tessera::io::image::ReadOptions {
         channel: args.channel.clone(),
         strict: args.strict,
@@ -146,20 +145,7 @@ pub(crate) fn sphere_map(
             raster.bad_pixels
         );
     }
-    if raster.width != 2 * raster.height {
-        eprintln!(
-            "tessera: warning: {name}: {}x{} is not a 2:1 lat-long map; sampling it as one",
-            raster.width, raster.height
-        );
-    }
-    let up = match args.up {
-        UpAxis::Z => Up::Z,
-        UpAxis::Y => Up::Y,
-    };
-    let map = EnvMap::new(raster, up).map_err(|e| Error::File {
-        path: path.into(),
-        reason: e.to_string(),
-    })?;
+    let map = env_map(path, raster, args.up)?;
     let map = match args.request.seed {
         Some(seed) => map.with_seed(seed),
         None => map,
@@ -188,4 +174,30 @@ pub(crate) fn print_report(points: &[glam::DVec3]) {
         covering_radius(points),
         mesh_ratio(points)
     );
+}
+
+/// The environment map of a raster read from `path`, warning when it is
+/// not 2:1 (shared by `sphere --map` and `lights`).
+pub(crate) fn env_map(
+    path: &Path,
+    raster: tessera::io::image::Raster,
+    up: UpAxis,
+) -> Result<tessera::density::envmap::EnvMap, Error> {
+    use tessera::density::envmap::{EnvMap, Up};
+    if raster.width != 2 * raster.height {
+        eprintln!(
+            "tessera: warning: {}: {}x{} is not a 2:1 lat-long map; using it as one",
+            path.display(),
+            raster.width,
+            raster.height
+        );
+    }
+    let up = match up {
+        UpAxis::Z => Up::Z,
+        UpAxis::Y => Up::Y,
+    };
+    EnvMap::new(raster, up).map_err(|e| Error::File {
+        path: path.into(),
+        reason: e.to_string(),
+    })
 }
