@@ -100,7 +100,7 @@ impl Light {
 
 /// The colour of a lat-long map: `(R, G, B)` per pixel, row-major, row 0
 /// on top, finite and `>= 0`, in the layout of
-/// [`EnvMap`](crate::density::envmap::EnvMap).
+/// [`EnvMap`].
 ///
 /// # Example
 /// ```
