@@ -28,10 +28,12 @@ pub mod optimize;
 pub mod plot;
 pub mod polyomino;
 pub mod random;
+pub mod relax;
 mod sample;
 mod sampler;
 pub mod synth;
 pub mod tiling;
+mod voronoi;
 
 pub use error::Error;
 pub use sample::Sample;

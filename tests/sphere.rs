@@ -308,3 +308,41 @@ fn streams_reach_the_deepest_level_without_buffering() {
         .collect();
     assert_eq!(distinct.len(), points.len());
 }
+
+/// `--relax`: Lloyd iterations approach a CVT's spacing from a set between
+/// bins and past level 3 (where the tables alone leave holes), and keep a
+/// cap's share of the points (the weight is the density squared).
+#[test]
+fn lloyd_relaxation_evens_spacing_and_keeps_the_density() {
+    use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
+    use tessera::relax::relax;
+    let positions = |samples: Vec<tessera::Sample<DVec3>>| -> Vec<DVec3> {
+        samples.into_iter().map(|s| s.position).collect()
+    };
+    let mut points = positions(Sampler::sphere().count(20_000).generate().unwrap());
+    assert!(
+        mesh_ratio(&points) > 4.0,
+        "the unrelaxed set has holes here"
+    );
+    relax(&mut points, &Uniform, 10).unwrap();
+    let (s, c, m) = (
+        separation(&points),
+        covering_radius(&points),
+        mesh_ratio(&points),
+    );
+    assert!(s > 2.6 && c < 2.85 && m < 2.1, "after 10: {s} {c} {m}");
+
+    let cap = Cap::new(10.0, 20.0, 30.0, 16.0).unwrap();
+    let tiling = SphereTiling::default();
+    let mut points = positions(engine::generate(&tiling, &cap, 20_000, true).unwrap());
+    let inside = |points: &[DVec3]| {
+        points.iter().filter(|&&p| cap.contains(p)).count() as f64 / points.len() as f64
+    };
+    let before = inside(&points);
+    relax(&mut points, &cap, 10).unwrap();
+    assert!(
+        (inside(&points) - before).abs() < 0.005,
+        "{before} -> {}",
+        inside(&points)
+    );
+}

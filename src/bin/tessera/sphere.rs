@@ -30,7 +30,7 @@ pub(crate) struct SphereArgs {
     /// `LON,LAT,RADIUS_DEG`: only the tiles reaching it are visited, so a
     /// small window on a huge request costs what the window holds. The count
     /// is the expected one (exactness is a property of the whole set).
-    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with_all = ["map", "seed"])]
+    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with_all = ["map", "seed", "relax"])]
     within: Option<String>,
     /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
     /// luminance per unit solid angle, constant per pixel. Replaces --density.
@@ -49,6 +49,13 @@ pub(crate) struct SphereArgs {
     /// warn once and treat them as 0.
     #[arg(long, requires = "map")]
     strict: bool,
+    /// Run K density-weighted Lloyd iterations on the set (about 3.5 s an
+    /// iteration for 10^6 points on two cores): spacing approaches a
+    /// centroidal Voronoi tessellation's, but prefixes are no longer
+    /// progressive (every point moves) and the set no longer follows the
+    /// density exactly, so the pdf column is the target density's.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    relax: usize,
     /// Print the set's separation, covering radius and mesh ratio (and a
     /// map's integral) to standard error.
     #[arg(long)]
@@ -109,13 +116,18 @@ where
     let tiling = SphereTiling::default();
     let mut out = create(&args.request.output)?;
     let written = match engine::stream(&tiling, args.request.count) {
-        Some(stream) if density.constant().is_some() && args.request.count > STREAM_ABOVE => {
+        Some(stream)
+            if density.constant().is_some()
+                && args.request.count > STREAM_ABOVE
+                && args.relax == 0 =>
+        {
             let points = stream.map(|s| to_world(s.position));
             tessera::io::points::write_sphere(&mut out, points, format, pdf)
         }
         _ => {
             let samples = args.request.generate(&tiling, density)?;
-            let points: Vec<glam::DVec3> = samples.iter().map(|s| to_world(s.position)).collect();
+            let points = relaxed(samples, density, args.relax)?;
+            let points: Vec<glam::DVec3> = points.into_iter().map(to_world).collect();
             if args.report {
                 print_report(&points);
             }
@@ -152,7 +164,8 @@ pub(crate) fn sphere_map(
     };
     let tiling = SphereTiling::default();
     let samples = args.request.generate(&tiling, &map)?;
-    let points: Vec<glam::DVec3> = samples.iter().map(|s| map.to_world(s.position)).collect();
+    let points = relaxed(samples, &map, args.relax)?;
+    let points: Vec<glam::DVec3> = points.into_iter().map(|p| map.to_world(p)).collect();
     if args.report {
         eprintln!("tessera: {name}: integral {} (value x sr)", map.integral());
         print_report(&points);
@@ -161,6 +174,21 @@ pub(crate) fn sphere_map(
     tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
         .and_then(|()| out.flush())
         .map_err(io_error(&args.request.output))
+}
+
+/// The positions of `samples` after `iterations` Lloyd iterations under
+/// `density` (in its sampling frame).
+fn relaxed<D>(
+    samples: Vec<tessera::Sample<glam::DVec3>>,
+    density: &D,
+    iterations: usize,
+) -> Result<Vec<glam::DVec3>, Error>
+where
+    D: Density<SphereRegion> + ?Sized,
+{
+    let mut points: Vec<glam::DVec3> = samples.into_iter().map(|s| s.position).collect();
+    tessera::relax::relax(&mut points, density, iterations)?;
+    Ok(points)
 }
 
 /// Separation, covering radius and mesh ratio of a point set (the O(N log N)

@@ -1,0 +1,219 @@
+//! Lloyd relaxation of a point set on the sphere toward a centroidal
+//! Voronoi tessellation (CVT) of a density: for users who want the most
+//! even spacing and accept losing the progressive order and the exact pdf.
+//!
+//! One iteration moves every point to the centroid of its spherical
+//! Voronoi cell ([`crate::voronoi`]), weighted by `density²`: in two
+//! dimensions a CVT of weight `w` has point density about `w^(1/2)`
+//! (Gersho's asymptotics), so the square keeps the point density
+//! proportional to the density itself. Each cell is integrated in the
+//! gnomonic chart of its site (area element `(1 + |u|²)^(-3/2) du`) by a
+//! degree-5, 7-point rule on a fan of triangles from the site, split in
+//! four when the density varies. Points move 1.8 times the way to their
+//! centroid (over-relaxation: faster, see [`OVER_RELAXATION`]). Cost O(N log N) an iteration (a k-d tree
+//! and k nearest neighbours a point), parallel with rayon.
+//!
+//! What it changes: prefixes of the relaxed set are no longer well spread
+//! (every point moves), and the points no longer follow the density
+//! exactly in expectation (a CVT is not a sample), so pdfs are those of
+//! the target density, not of the relaxed set.
+
+use crate::density::Density;
+use crate::tiling::sphere::SphereRegion;
+use crate::voronoi::{build_tree, cell_of, clip_chart, tangent_basis, CHART_HALF};
+use crate::Error;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Runs `iterations` density-weighted Lloyd iterations on `points` (unit
+/// vectors) in place. A point whose cell has no weight (zero density) or
+/// is wider than a hemisphere stays where it is.
+///
+/// Errors: a point that is not a finite unit vector (to 1e-6).
+///
+/// # Example
+/// ```
+/// use tessera::{density::Uniform, metrics::sphere::mesh_ratio, relax::relax, Sampler};
+/// let mut points: Vec<_> = Sampler::sphere().count(2000).generate().unwrap()
+///     .into_iter().map(|s| s.position).collect();
+/// let before = mesh_ratio(&points);
+/// relax(&mut points, &Uniform, 3).unwrap();
+/// assert!(mesh_ratio(&points) < before);
+/// ```
+pub fn relax<D>(points: &mut [DVec3], density: &D, iterations: usize) -> Result<(), Error>
+where
+    D: Density<SphereRegion> + ?Sized,
+{
+    if let Some(i) = points
+        .iter()
+        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
+    {
+        return Err(Error::Request(format!(
+            "relax: point {i} ({}) is not a unit vector",
+            points[i]
+        )));
+    }
+    if points.len() < 2 {
+        return Ok(());
+    }
+    let weight = |x: DVec3| match density.constant() {
+        Some(_) => 1.0,
+        None => density.value(x).max(0.0).powi(2),
+    };
+    let split = density.constant().is_none();
+    for _ in 0..iterations {
+        let tree = build_tree(points);
+        let moved: Vec<DVec3> = (0..points.len())
+            .into_par_iter()
+            .map_init(Vec::new, |normals, i| {
+                cell_of(points, Some(&tree), i, normals);
+                let p = points[i];
+                centroid(p, normals, split, &weight)
+                    .map_or(p, |c| (p + OVER_RELAXATION * (c - p)).normalize())
+            })
+            .collect();
+        points.copy_from_slice(&moved);
+    }
+    Ok(())
+}
+
+/// The `weight`-weighted centroid of the Voronoi cell of `p` bounded by
+/// `normals`, projected to the sphere; `None` when the cell leaves the
+/// chart (wider than about 76°) or has no weight.
+fn centroid(
+    p: DVec3,
+    normals: &[DVec3],
+    split: bool,
+    weight: &impl Fn(DVec3) -> f64,
+) -> Option<DVec3> {
+    let (_, moment) = cell_integrals(p, normals, split, weight)?;
+    let length = moment.length();
+    (length > 0.0 && length.is_finite()).then(|| moment / length)
+}
+
+/// `(∫ w dA, ∫ w x dA)` over the Voronoi cell of `p` bounded by `normals`;
+/// `None` when the cell leaves the chart.
+fn cell_integrals(
+    p: DVec3,
+    normals: &[DVec3],
+    split: bool,
+    weight: &impl Fn(DVec3) -> f64,
+) -> Option<(f64, DVec3)> {
+    let (ea, eb) = tangent_basis(p);
+    let poly = clip_chart(p, ea, eb, CHART_HALF, normals);
+    let limit = CHART_HALF * (1.0 - 1e-9);
+    if poly.len() < 3
+        || poly
+            .iter()
+            .any(|u| u[0].abs() >= limit || u[1].abs() >= limit)
+    {
+        return None;
+    }
+    // ∫ w(x) x dA over the cell; x(u) = (p + a ea + b eb) / |...|
+    let (mut mass, mut moment) = (0.0, DVec3::ZERO);
+    let mut triangle = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs();
+        for (bary, w) in RADON_7 {
+            let u = [
+                bary[0] * a[0] + bary[1] * b[0] + bary[2] * c[0],
+                bary[0] * a[1] + bary[1] * b[1] + bary[2] * c[1],
+            ];
+            let r2 = 1.0 + u[0] * u[0] + u[1] * u[1];
+            let x = (p + u[0] * ea + u[1] * eb) / r2.sqrt();
+            // area element of the gnomonic chart: (1 + |u|^2)^(-3/2)
+            let dm = w * area * weight(x) / (r2 * r2.sqrt());
+            mass += dm;
+            moment += x * dm;
+        }
+    };
+    let origin = [0.0, 0.0];
+    for k in 0..poly.len() {
+        let (b, c) = (poly[k], poly[(k + 1) % poly.len()]);
+        if !split {
+            triangle(origin, b, c);
+            continue;
+        }
+        let mid = |s: [f64; 2], t: [f64; 2]| [0.5 * (s[0] + t[0]), 0.5 * (s[1] + t[1])];
+        let (ab, bc, ca) = (mid(origin, b), mid(b, c), mid(c, origin));
+        triangle(origin, ab, ca);
+        triangle(ab, b, bc);
+        triangle(ca, bc, c);
+        triangle(ab, bc, ca);
+    }
+    Some((mass, moment))
+}
+
+/// How far past its cell's centroid a point moves (1 is plain Lloyd).
+/// From a uniform tessera set, the mesh ratio after 3 iterations was 2.56,
+/// 2.34 and 2.36 at N = 20000, and 2.68, 2.44 and 2.36 at N = 200000, for
+/// 1, 1.5 and 1.8; after 10, 2.02, 1.96 and 1.94 at N = 20000 (scratch
+/// runs, not kept).
+const OVER_RELAXATION: f64 = 1.8;
+
+/// Radon's degree-5 rule on a triangle: barycentric points and weights
+/// (of the area), exact for polynomials of degree 5.
+const RADON_7: [([f64; 3], f64); 7] = {
+    // (6 ∓ √15) / 21, (9 ± 2√15) / 21 and (155 ∓ √15) / 1200, √15 written out
+    const S: f64 = 3.872_983_346_207_417;
+    const A1: f64 = (6.0 - S) / 21.0;
+    const B1: f64 = (9.0 + 2.0 * S) / 21.0;
+    const W1: f64 = (155.0 - S) / 1200.0;
+    const A2: f64 = (6.0 + S) / 21.0;
+    const B2: f64 = (9.0 - 2.0 * S) / 21.0;
+    const W2: f64 = (155.0 + S) / 1200.0;
+    const T: f64 = 1.0 / 3.0;
+    [
+        ([T, T, T], 9.0 / 40.0),
+        ([A1, A1, B1], W1),
+        ([A1, B1, A1], W1),
+        ([B1, A1, A1], W1),
+        ([A2, A2, B2], W2),
+        ([A2, B2, A2], W2),
+        ([B2, A2, A2], W2),
+    ]
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::density::Uniform;
+    use approx::assert_relative_eq;
+
+    /// The cell of the north pole against the four equatorial vertices of
+    /// the octahedron is symmetric about the pole: its centroid is the pole.
+    #[test]
+    fn a_symmetric_cell_keeps_its_site() {
+        let p = DVec3::Z;
+        let normals: Vec<DVec3> = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y]
+            .iter()
+            .map(|&q| p - q)
+            .collect();
+        let c = centroid(p, &normals, true, &|_| 1.0).unwrap();
+        assert!((c - DVec3::Z).length() < 1e-12, "{c}");
+        // the cell is the cube face z >= |x|, |y|: a sixth of the sphere
+        for split in [false, true] {
+            let (area, _) = cell_integrals(p, &normals, split, &|_| 1.0).unwrap();
+            assert_relative_eq!(area, 4.0 * std::f64::consts::PI / 6.0, max_relative = 1e-3);
+        }
+        // a weight growing with x pulls the centroid toward +x
+        let c = centroid(p, &normals, true, &|x: DVec3| 1.0 + x.x).unwrap();
+        assert!(c.x > 0.01 && c.y.abs() < 1e-12, "{c}");
+    }
+
+    /// Weights sum to 1 and reproduce a quadratic's integral.
+    #[test]
+    fn radon_rule_is_exact_for_low_degrees() {
+        let sum: f64 = RADON_7.iter().map(|(_, w)| w).sum();
+        assert_relative_eq!(sum, 1.0, epsilon = 1e-15);
+        // ∫ x² over the unit right triangle = 1/12, area 1/2
+        let x2: f64 = RADON_7.iter().map(|(b, w)| w * b[1] * b[1]).sum::<f64>() * 0.5;
+        assert_relative_eq!(x2, 1.0 / 12.0, epsilon = 1e-15);
+    }
+
+    #[test]
+    fn refuses_points_off_the_sphere() {
+        let mut points = vec![DVec3::Z, DVec3::new(0.0, 0.0, 2.0)];
+        let e = relax(&mut points, &Uniform, 1).unwrap_err().to_string();
+        assert!(e.contains("point 1"), "{e}");
+    }
+}

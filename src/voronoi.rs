@@ -1,0 +1,203 @@
+//! Spherical Voronoi cells, each clipped in a gnomonic chart centred on its
+//! site from its k nearest neighbours (k-d tree), k doubled until a
+//! radius-of-security test certifies the cell. Shared by the covering
+//! radius ([`crate::metrics::sphere::covering_radius`]) and Lloyd
+//! relaxation ([`crate::relax`]).
+
+use glam::DVec3;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use std::f64::consts::PI;
+use std::num::NonZero;
+
+/// A k-d tree over the 3-D coordinates of unit vectors.
+pub(crate) type Tree3 = ImmutableKdTree<f64, 3>;
+
+/// The k-d tree of `points`.
+pub(crate) fn build_tree(points: &[DVec3]) -> Tree3 {
+    let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
+    ImmutableKdTree::new_from_slice(&coords)
+}
+
+/// Polygon vertices in a gnomonic chart (coordinates `(a, b)`).
+pub(crate) type Poly = Vec<[f64; 2]>;
+
+/// Clips the convex polygon `poly` by the half-plane `c0 + c1 a + c2 b ≥ 0`
+/// (Sutherland–Hodgman), writing the result to `out`.
+pub(crate) fn clip(poly: &Poly, c: [f64; 3], out: &mut Poly) {
+    out.clear();
+    let f = |u: &[f64; 2]| c[0] + c[1] * u[0] + c[2] * u[1];
+    let Some(mut prev) = poly.last() else {
+        return;
+    };
+    let mut fp = f(prev);
+    for cur in poly {
+        let fc = f(cur);
+        if (fc >= 0.0) != (fp >= 0.0) {
+            let t = fp / (fp - fc);
+            out.push([
+                prev[0] + t * (cur[0] - prev[0]),
+                prev[1] + t * (cur[1] - prev[1]),
+            ]);
+        }
+        if fc >= 0.0 {
+            out.push(*cur);
+        }
+        prev = cur;
+        fp = fc;
+    }
+}
+
+/// Clips the square `[-half, half]²` of the gnomonic chart
+/// `u ↦ e + a ea + b eb` by the hemispheres `x · n ≥ 0`.
+pub(crate) fn clip_chart(e: DVec3, ea: DVec3, eb: DVec3, half: f64, normals: &[DVec3]) -> Poly {
+    let mut poly: Poly = vec![[-half, -half], [half, -half], [half, half], [-half, half]];
+    let mut tmp = Poly::with_capacity(16);
+    for n in normals {
+        clip(&poly, [n.dot(e), n.dot(ea), n.dot(eb)], &mut tmp);
+        std::mem::swap(&mut poly, &mut tmp);
+        if poly.is_empty() {
+            break;
+        }
+    }
+    poly
+}
+
+/// Unit tangent basis `(ea, eb)` at `p`, right-handed with `p`.
+pub(crate) fn tangent_basis(p: DVec3) -> (DVec3, DVec3) {
+    let helper = if p.x.abs() <= p.y.abs() && p.x.abs() <= p.z.abs() {
+        DVec3::X
+    } else if p.y.abs() <= p.z.abs() {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    };
+    let ea = helper.cross(p).normalize();
+    (ea, p.cross(ea))
+}
+
+/// Half-width of the chart square centred on the sample (`tan` of about
+/// 76°); cells reaching beyond it use the cube-face fallback.
+pub(crate) const CHART_HALF: f64 = 4.0;
+
+/// Largest geodesic distance from `p` to the points of the spherical convex
+/// region `{x : x · n ≥ 0 for all n in normals}` (the Voronoi cell of `p` when
+/// `normals` are `p − q` for its competitors). Exact up to rounding.
+fn cell_radius(p: DVec3, normals: &[DVec3]) -> f64 {
+    // Fast path: a gnomonic chart centred on p. If the clipped polygon stays
+    // strictly inside the chart square, it is the whole cell, which then lies
+    // in the open hemisphere around p; there the distance to p is maximal at
+    // a vertex, and the distance of the chart point u is atan(|u|).
+    let (ea, eb) = tangent_basis(p);
+    let poly = clip_chart(p, ea, eb, CHART_HALF, normals);
+    let limit = CHART_HALF * (1.0 - 1e-9);
+    if !poly.is_empty()
+        && poly
+            .iter()
+            .all(|u| u[0].abs() < limit && u[1].abs() < limit)
+    {
+        let r2 = poly
+            .iter()
+            .map(|u| u[0] * u[0] + u[1] * u[1])
+            .fold(0.0, f64::max);
+        return r2.sqrt().atan();
+    }
+    cell_radius_cube(p, normals)
+}
+
+/// General (wide cells) version of [`cell_radius`]: the cell is cut by the six
+/// faces of the cube map, each piece clipped in its face's gnomonic chart;
+/// the maximum distance is taken over the vertices, over the interior points
+/// of the edges nearest to the antipode of `p`, and over the antipode itself.
+fn cell_radius_cube(p: DVec3, normals: &[DVec3]) -> f64 {
+    let anti = -p;
+    if normals.iter().all(|n| anti.dot(*n) >= 0.0) {
+        return PI;
+    }
+    let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+    let mut best: f64 = 0.0;
+    for k in 0..3 {
+        for sign in [1.0, -1.0] {
+            let e = axes[k] * sign;
+            let ea = axes[(k + 1) % 3];
+            let eb = axes[(k + 2) % 3] * sign;
+            let poly = clip_chart(e, ea, eb, 1.0, normals);
+            let verts: Vec<DVec3> = poly
+                .iter()
+                .map(|u| (e + u[0] * ea + u[1] * eb).normalize())
+                .collect();
+            for (idx, &v) in verts.iter().enumerate() {
+                best = best.max(geodesic(p, v));
+                let w = verts[(idx + 1) % verts.len()];
+                // Point of the great-circle arc v → w nearest to the antipode.
+                let m = v.cross(w);
+                if m.length_squared() < 1e-300 {
+                    continue;
+                }
+                let m = m.normalize();
+                let proj = anti - anti.dot(m) * m;
+                if proj.length_squared() < 1e-300 {
+                    continue;
+                }
+                let q = proj.normalize();
+                if v.cross(q).dot(m) >= 0.0 && q.cross(w).dot(m) >= 0.0 {
+                    best = best.max(geodesic(p, q));
+                }
+            }
+        }
+    }
+    best
+}
+
+/// The Voronoi cell of `points[i]` as the half-spaces `x · n ≥ 0` that
+/// bound it, into `normals` (`p − q` for its competitors `q`): the nearest
+/// neighbours from the tree, certified by the radius-of-security test, or
+/// all points when `tree` is `None`. Returns the cell's radius (the largest
+/// geodesic distance from the site to its cell).
+pub(crate) fn cell_of(
+    points: &[DVec3],
+    tree: Option<&Tree3>,
+    i: usize,
+    normals: &mut Vec<DVec3>,
+) -> f64 {
+    let p = points[i];
+    let n = points.len();
+    let others = |normals: &mut Vec<DVec3>, j: usize| {
+        let d = p - points[j];
+        if j != i && d != DVec3::ZERO {
+            normals.push(d);
+        }
+    };
+    normals.clear();
+    let Some(tree) = tree else {
+        (0..n).for_each(|j| others(normals, j));
+        return cell_radius(p, normals);
+    };
+    let mut k = 24usize;
+    loop {
+        normals.clear();
+        if k + 1 >= n {
+            (0..n).for_each(|j| others(normals, j));
+            return cell_radius(p, normals);
+        }
+        let found = tree.nearest_n::<SquaredEuclidean>(&p.to_array(), NonZero::new(k + 1).unwrap());
+        for nn in &found {
+            others(normals, nn.item as usize);
+        }
+        let radius = cell_radius(p, normals);
+        // Every point not fetched is at least this far (chordal) from p.
+        let fetched = found.last().map_or(0.0, |nn| nn.distance.sqrt());
+        // Points x of the clipped cell satisfy |x − p| ≤ r (chordal); a point
+        // q with |q − p| ≥ 2r has |x − q| ≥ r ≥ |x − p| and cannot clip it.
+        let chord = 2.0 * (0.5 * radius).sin();
+        if fetched >= 2.0 * chord {
+            return radius;
+        }
+        k *= 2;
+    }
+}
+
+/// Geodesic angle between two unit vectors, `atan2(|a × b|, a · b)`: accurate
+/// for all angles, including nearly coincident and nearly antipodal points.
+pub(crate) fn geodesic(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
