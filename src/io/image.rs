@@ -221,9 +221,139 @@ fn damaged(values: &[f64], width: usize) -> Option<(usize, f64)> {
 }
 
 /// A named channel of decoded samples.
-struct Channel {
-    name: String,
-    samples: Vec<f32>,
+pub(crate) struct Channel {
+    pub(crate) name: String,
+    pub(crate) samples: Vec<f32>,
+}
+
+/// An image file's channels as its decoder gave them: what both the
+/// importance ([`read_raster`]) and the colour of lights read.
+pub(crate) struct Decoded {
+    pub(crate) width: usize,
+    pub(crate) height: usize,
+    pub(crate) channels: Vec<Channel>,
+    /// Integer formats hold display (sRGB) values; float formats are linear.
+    srgb: bool,
+}
+
+impl Decoded {
+    /// Decodes an EXR, Radiance `.hdr` or PNG file, recognised by its first
+    /// bytes, not its name.
+    pub(crate) fn read(path: &Path) -> Result<Decoded, Error> {
+        let fail = |reason: String| Error::File {
+            path: path.into(),
+            reason,
+        };
+        let mut magic = [0u8; 8];
+        let head = {
+            use std::io::Read;
+            let mut file = std::fs::File::open(path).map_err(|source| Error::Io {
+                path: path.into(),
+                source,
+            })?;
+            let mut n = 0;
+            while n < magic.len() {
+                match file.read(&mut magic[n..]) {
+                    Ok(0) => break,
+                    Ok(k) => n += k,
+                    Err(source) => {
+                        return Err(Error::Io {
+                            path: path.into(),
+                            source,
+                        })
+                    }
+                }
+            }
+            &magic[..n]
+        };
+        // the decoders are third-party code fed hostile bytes: a panic in
+        // one becomes an error naming the file
+        let guarded = |decode: &dyn Fn() -> Result<Decoded, String>| {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
+                .unwrap_or_else(|_| Err("the decoder failed on this file".into()))
+                .map_err(fail)
+        };
+        if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            guarded(&|| read_exr(path))
+        } else if head.starts_with(b"#?") || head.starts_with(b"\x89PNG") {
+            guarded(&|| read_with_image_crate(path))
+        } else if head.is_empty() {
+            Err(fail("the file is empty".into()))
+        } else {
+            Err(fail(
+                "not an OpenEXR, Radiance .hdr or PNG file (unrecognised first bytes)".into(),
+            ))
+        }
+    }
+
+    /// A channel by exact name, else by its last `.`-separated part,
+    /// ignoring case.
+    pub(crate) fn find(&self, wanted: &str) -> Option<&Channel> {
+        let channels = &self.channels;
+        channels.iter().find(|c| c.name == wanted).or_else(|| {
+            channels.iter().find(|c| {
+                let short = c.name.rsplit('.').next().unwrap_or(&c.name);
+                short.eq_ignore_ascii_case(wanted)
+            })
+        })
+    }
+
+    /// A sample as a linear value (sRGB decoded when the format holds
+    /// display values and `options` asks for it).
+    pub(crate) fn linear(&self, options: &ReadOptions, v: f32) -> f64 {
+        let v = v as f64;
+        if self.srgb && options.decode_srgb {
+            srgb_to_linear(v)
+        } else {
+            v
+        }
+    }
+
+    /// The channel names, for messages.
+    fn names(&self) -> String {
+        let names: Vec<&str> = self.channels.iter().map(|c| c.name.as_str()).collect();
+        names.join(", ")
+    }
+
+    /// The importance per pixel: `options.channel`, else Rec.709 luminance
+    /// of R, G and B, else Y (NaN where a colour sample is not finite).
+    pub(crate) fn importance(&self, path: &Path, options: &ReadOptions) -> Result<Vec<f64>, Error> {
+        let fail = |reason: String| Error::File {
+            path: path.into(),
+            reason,
+        };
+        let decode = |v: f32| self.linear(options, v);
+        if let Some(wanted) = &options.channel {
+            let channel = self.find(wanted).ok_or_else(|| {
+                fail(format!(
+                    "no channel named '{wanted}'; the file has: {}",
+                    self.names()
+                ))
+            })?;
+            return Ok(channel.samples.iter().map(|&v| decode(v)).collect());
+        }
+        match (self.find("R"), self.find("G"), self.find("B"), self.find("Y")) {
+            (Some(r), Some(g), Some(b), _) => Ok(r
+                .samples
+                .iter()
+                .zip(&g.samples)
+                .zip(&b.samples)
+                .map(|((&r, &g), &b)| {
+                    let (r, g, b) = (decode(r), decode(g), decode(b));
+                    if r.is_finite() && g.is_finite() && b.is_finite() {
+                        0.2126 * r + 0.7152 * g + 0.0722 * b
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()),
+            (_, _, _, Some(y)) => Ok(y.samples.iter().map(|&v| decode(v)).collect()),
+            _ => Err(fail(format!(
+                "no R, G, B or Y channels for luminance (the file has: {}); pick one with --channel",
+                self.names()
+            ))),
+        }
+    }
 }
 
 /// Reads an EXR, Radiance `.hdr` or PNG file (recognised by its first
@@ -240,115 +370,9 @@ struct Channel {
 /// assert!((r.get(1, 0) - (0.2126 + 0.7152)).abs() < 1e-6);
 /// ```
 pub fn read_raster(path: &Path, options: &ReadOptions) -> Result<Raster, Error> {
-    let fail = |reason: String| Error::File {
-        path: path.into(),
-        reason,
-    };
-    let mut magic = [0u8; 8];
-    let head = {
-        use std::io::Read;
-        let mut file = std::fs::File::open(path).map_err(|source| Error::Io {
-            path: path.into(),
-            source,
-        })?;
-        let mut n = 0;
-        while n < magic.len() {
-            match file.read(&mut magic[n..]) {
-                Ok(0) => break,
-                Ok(k) => n += k,
-                Err(source) => {
-                    return Err(Error::Io {
-                        path: path.into(),
-                        source,
-                    })
-                }
-            }
-        }
-        &magic[..n]
-    };
-    // the decoders are third-party code fed hostile bytes: a panic in one
-    // becomes an error naming the file
-    let guarded = |decode: &dyn Fn() -> Result<(usize, usize, Vec<Channel>, bool), String>| {
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
-            .unwrap_or_else(|_| Err("the decoder failed on this file".into()))
-            .map_err(fail)
-    };
-    let (width, height, channels, srgb) = if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        guarded(&|| read_exr(path).map(|(w, h, c)| (w, h, c, false)))?
-    } else if head.starts_with(b"#?") || head.starts_with(b"\x89PNG") {
-        guarded(&|| read_with_image_crate(path))?
-    } else if head.is_empty() {
-        return Err(fail("the file is empty".into()));
-    } else {
-        return Err(fail(
-            "not an OpenEXR, Radiance .hdr or PNG file (unrecognised first bytes)".into(),
-        ));
-    };
-    let decode = |v: f32| {
-        let v = v as f64;
-        if srgb && options.decode_srgb {
-            srgb_to_linear(v)
-        } else {
-            v
-        }
-    };
-    let names = || {
-        channels
-            .iter()
-            .map(|c| c.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let values: Vec<f64> = match &options.channel {
-        Some(wanted) => {
-            let channel = find(&channels, wanted).ok_or_else(|| {
-                fail(format!(
-                    "no channel named '{wanted}'; the file has: {}",
-                    names()
-                ))
-            })?;
-            channel.samples.iter().map(|&v| decode(v)).collect()
-        }
-        None => match (
-            find(&channels, "R"),
-            find(&channels, "G"),
-            find(&channels, "B"),
-            find(&channels, "Y"),
-        ) {
-            (Some(r), Some(g), Some(b), _) => r
-                .samples
-                .iter()
-                .zip(&g.samples)
-                .zip(&b.samples)
-                .map(|((&r, &g), &b)| {
-                    let (r, g, b) = (decode(r), decode(g), decode(b));
-                    if r.is_finite() && g.is_finite() && b.is_finite() {
-                        0.2126 * r + 0.7152 * g + 0.0722 * b
-                    } else {
-                        f64::NAN
-                    }
-                })
-                .collect(),
-            (_, _, _, Some(y)) => y.samples.iter().map(|&v| decode(v)).collect(),
-            _ => {
-                return Err(fail(format!(
-                    "no R, G, B or Y channels for luminance (the file has: {}); pick one with --channel",
-                    names()
-                )))
-            }
-        },
-    };
-    Raster::from_values(path, width, height, values, options.strict)
-}
-
-/// A channel by exact name, else by its last `.`-separated part, ignoring case.
-fn find<'a>(channels: &'a [Channel], wanted: &str) -> Option<&'a Channel> {
-    channels.iter().find(|c| c.name == wanted).or_else(|| {
-        channels.iter().find(|c| {
-            let short = c.name.rsplit('.').next().unwrap_or(&c.name);
-            short.eq_ignore_ascii_case(wanted)
-        })
-    })
+    let decoded = Decoded::read(path)?;
+    let values = decoded.importance(path, options)?;
+    Raster::from_values(path, decoded.width, decoded.height, values, options.strict)
 }
 
 /// The sRGB electro-optical transfer function (IEC 61966-2-1).
@@ -360,7 +384,7 @@ fn srgb_to_linear(v: f64) -> f64 {
     }
 }
 
-fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Channel>), String> {
+fn read_exr(path: &Path) -> Result<Decoded, String> {
     use exr::prelude::*;
     // the header first: refuse absurd sizes before allocating for them
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
@@ -371,14 +395,19 @@ fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Channel>), String> {
         .ok_or("the file holds only deep data, which has no per-pixel value")?;
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     check_size(w, h)?;
-    let image = read()
+    let reader = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| e.to_string())?;
+        .all_attributes();
+    // decode on the caller's threads: one thread asked, one thread used
+    let image = if rayon::current_num_threads() == 1 {
+        reader.non_parallel().from_file(path)
+    } else {
+        reader.from_file(path)
+    }
+    .map_err(|e| e.to_string())?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
     check_size(w, h)?;
@@ -394,7 +423,12 @@ fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Channel>), String> {
         let samples = c.sample_data.values_as_f32().collect();
         channels.push(Channel { name, samples });
     }
-    Ok((w, h, channels))
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels,
+        srgb: false,
+    })
 }
 
 fn check_size(w: usize, h: usize) -> Result<(), String> {
@@ -409,7 +443,7 @@ fn check_size(w: usize, h: usize) -> Result<(), String> {
     }
 }
 
-fn read_with_image_crate(path: &Path) -> Result<(usize, usize, Vec<Channel>, bool), String> {
+fn read_with_image_crate(path: &Path) -> Result<Decoded, String> {
     let reader = image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
         .map_err(|e| e.to_string())?;
@@ -454,5 +488,10 @@ fn read_with_image_crate(path: &Path) -> Result<(usize, usize, Vec<Channel>, boo
             samples: plane(3),
         });
     }
-    Ok((w, h, channels, srgb))
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels,
+        srgb,
+    })
 }
