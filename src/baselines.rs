@@ -1,6 +1,7 @@
 //! Baseline point sets to compare samplers against: the spherical Fibonacci
 //! lattice, independent uniform points on the sphere and in the square, the
-//! jittered grid and jittered HEALPix, Owen-scrambled Sobol ([`sobol`])
+//! jittered grid and jittered HEALPix, weighted sample elimination
+//! ([`elimination`]), Owen-scrambled Sobol ([`sobol`])
 //! warped by inverse CDFs ([`cdf`], [`envmap`]), with a small self-contained RNG ([`SplitMix64`]) so
 //! that results are reproducible from a seed without extra dependencies.
 //!
@@ -12,6 +13,7 @@
 //! ```
 
 pub mod cdf;
+pub mod elimination;
 pub mod envmap;
 pub mod median_cut;
 pub mod sobol;

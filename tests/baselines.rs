@@ -114,3 +114,18 @@ fn cell_nside4(v: glam::DVec3) -> u64 {
     let (lon, lat) = (v.y.atan2(v.x), v.z.asin());
     cdshealpix::nested::hash(2, lon.rem_euclid(std::f64::consts::TAU), lat)
 }
+
+/// Weighted sample elimination keeps the spacing its paper reports
+/// (separation about 2.4, covering about 4) and is reproducible.
+#[test]
+fn weighted_sample_elimination_spreads_points() {
+    use tessera::baselines::elimination::weighted_sample_elimination;
+    use tessera::metrics::sphere::{covering_radius, separation};
+    let points = weighted_sample_elimination(3000, 7);
+    assert_eq!(points.len(), 3000);
+    assert!(points.iter().all(|p| (p.length() - 1.0).abs() < 1e-12));
+    let (s, c) = (separation(&points), covering_radius(&points));
+    assert!(s > 2.3 && c < 4.8, "separation {s}, covering {c}");
+    assert_eq!(points, weighted_sample_elimination(3000, 7));
+    assert!(weighted_sample_elimination(0, 7).is_empty());
+}

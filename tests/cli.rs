@@ -402,3 +402,30 @@ fn seeds_randomise_every_density_and_the_plane_writes_pdfs() {
         run(&[&plane[..], &["--seed", "4"]].concat())
     );
 }
+
+/// `--relax K` evens a set between bins (its report says so), keeps the
+/// count, and refuses a window (relaxation needs the whole set).
+#[test]
+fn relax_evens_the_set_and_refuses_a_window() {
+    let mesh = |relax: &str| -> f64 {
+        let out = tessera(&[
+            "sphere", "-n", "20000", "--relax", relax, "--report", "-o", "-",
+        ]);
+        assert!(out.status.success());
+        assert_eq!(
+            String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .filter(|l| !l.starts_with('#'))
+                .count(),
+            20000
+        );
+        let report = String::from_utf8_lossy(&out.stderr).to_string();
+        let ratio = report.split("mesh ratio ").nth(1).expect("a report");
+        ratio.trim().parse().expect("a number")
+    };
+    let (before, after) = (mesh("0"), mesh("3"));
+    assert!(before > 4.0 && after < 2.6, "{before} -> {after}");
+    let out = tessera(&["sphere", "-n", "100", "--within", "0,0,10", "--relax", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--relax"));
+}
