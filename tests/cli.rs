@@ -429,3 +429,41 @@ fn relax_evens_the_set_and_refuses_a_window() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--relax"));
 }
+
+/// Usage errors exit 2 and list the choices, whether clap or the library
+/// finds them; data errors exit 1 and name the input.
+#[test]
+fn usage_errors_exit_2_and_data_errors_exit_1() {
+    for (args, needle) in [
+        (
+            vec!["sphere", "-n", "10", "--format", "blah"],
+            "possible values",
+        ),
+        (
+            vec![
+                "plane",
+                "--system",
+                "ghexomino",
+                "-n",
+                "10",
+                "--format",
+                "xyz",
+            ],
+            "possible values",
+        ),
+        (vec!["sphere", "-n", "10", "--density", "blah"], "polygon:"),
+        (vec!["sphere", "-n", "-5"], "'-5'"),
+    ] {
+        let out = tessera(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    let dir = std::env::temp_dir().join(format!("tessera-exit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let garbage = dir.join("garbage.exr");
+    std::fs::write(&garbage, "not an image").unwrap();
+    let out = tessera(&["sphere", "-n", "10", "--map", garbage.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.exr"));
+}

@@ -589,8 +589,9 @@ fn cli_writes_text_and_utk_binary_and_refuses_bad_input() {
             "level 3",
         ),
     ] {
+        // usage errors: what was asked
         let out = tessera(args);
-        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(why), "{args:?}: {err}");
     }
@@ -646,7 +647,7 @@ fn cli_samples_a_png_file_and_its_inverse() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.png"));
     let out = tessera(&["plane", "--system", "ppentomino", "--invert", "-n", "5"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
 }
 
 /// How far the offset tables carry points beyond their tile's bounding box,

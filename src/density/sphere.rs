@@ -300,7 +300,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Density<SphereRegion> + Send>, Error>
             });
     }
     Err(fail(
-        "unknown density; expected 'uniform' or 'cap:LON,LAT,RADIUS_DEG,CONTRAST'",
+        "unknown density; expected 'uniform', 'cap:LON,LAT,RADIUS_DEG,CONTRAST' or 'polygon:LON LAT,LON LAT,...;CONTRAST'",
     ))
 }
 

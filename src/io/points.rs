@@ -47,7 +47,7 @@ impl std::str::FromStr for SphereFormat {
             "geojson" => Ok(SphereFormat::GeoJson),
             "bin" => Ok(SphereFormat::Bin),
             other => Err(Error::Request(format!(
-                "unknown format '{other}'; expected xyz, lonlat, csv, geojson or bin"
+                "unknown format '{other}'; expected xyz (or txt), lonlat, csv, geojson or bin"
             ))),
         }
     }
@@ -444,11 +444,11 @@ impl std::str::FromStr for PlaneFormat {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
         match s {
-            "txt" => Ok(PlaneFormat::Txt),
+            "xy" | "txt" => Ok(PlaneFormat::Txt),
             "bin" => Ok(PlaneFormat::Bin),
             "csv" => Ok(PlaneFormat::Csv),
             other => Err(Error::Request(format!(
-                "unknown planar format '{other}'; expected txt, bin or csv"
+                "unknown planar format '{other}'; expected xy (or txt), bin or csv"
             ))),
         }
     }

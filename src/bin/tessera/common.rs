@@ -13,7 +13,7 @@ use tessera::{engine, Error};
 #[derive(Args)]
 pub(crate) struct RequestArgs {
     /// Number of samples (exact unless --expected).
-    #[arg(short = 'n', long = "count")]
+    #[arg(short = 'n', long = "count", allow_hyphen_values = true)]
     pub(crate) count: usize,
     /// Skip the exactness pass: return the natural count near N.
     #[arg(long)]

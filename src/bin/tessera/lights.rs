@@ -13,7 +13,7 @@ pub(crate) struct LightsArgs {
     #[arg(long)]
     map: PathBuf,
     /// Number of lights (exactly this many).
-    #[arg(short = 'n', long = "count")]
+    #[arg(short = 'n', long = "count", allow_hyphen_values = true)]
     count: usize,
     /// Output file, `-` for standard output.
     #[arg(short, long, default_value = "-")]

@@ -93,7 +93,12 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("tessera: {e}");
-            ExitCode::FAILURE
+            // usage errors (what was asked) exit 2, as clap's do; data
+            // errors (what a file holds, or the system) exit 1
+            match e {
+                tessera::Error::Density(..) | tessera::Error::Request(_) => ExitCode::from(2),
+                _ => ExitCode::FAILURE,
+            }
         }
     }
 }

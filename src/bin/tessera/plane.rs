@@ -1,6 +1,7 @@
 //! `tessera plane`: samples of the unit square or a rectangle.
 
 use crate::common::*;
+use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use tessera::density::plane::Shifted;
@@ -34,9 +35,10 @@ pub(crate) struct PlaneArgs {
     invert: bool,
     #[command(flatten)]
     request: RequestArgs,
-    /// txt: `x y` per line; bin: UTK binary (f64, 2 dimensions); csv:
-    /// `x,y,pdf` (pdf per unit area of the domain).
-    #[arg(long, default_value = "txt")]
+    /// xy (or txt, the plain text of either domain): `x y` per line; bin:
+    /// UTK binary (f64, 2 dimensions); csv: `x,y,pdf` (pdf per unit area of
+    /// the domain).
+    #[arg(long, default_value = "xy", value_parser = PossibleValuesParser::new(["xy", "txt", "bin", "csv"]))]
     format: String,
     /// Sample the rectangle `x0,y0,x1,y1` instead of the unit square (the
     /// density's unit square stretched over it).

@@ -1,6 +1,7 @@
 //! `tessera sphere`: samples of the unit sphere.
 
 use crate::common::*;
+use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -21,10 +22,11 @@ pub(crate) struct SphereArgs {
     density: Vec<String>,
     #[command(flatten)]
     request: RequestArgs,
-    /// xyz: `x y z` per line; lonlat: `lon lat` degrees; csv: header and a pdf
-    /// column; geojson: a FeatureCollection of Points with a pdf property;
-    /// bin: UTK binary (f64, 3 dimensions).
-    #[arg(long, default_value = "xyz")]
+    /// xyz (or txt, the plain text of either domain): `x y z` per line;
+    /// lonlat: `lon lat` degrees; csv: header and a pdf column; geojson: a
+    /// FeatureCollection of Points with a pdf property; bin: UTK binary
+    /// (f64, 3 dimensions).
+    #[arg(long, default_value = "xyz", value_parser = PossibleValuesParser::new(["xyz", "txt", "lonlat", "csv", "geojson", "bin"]))]
     format: String,
     /// Write only the samples of the request that fall in this cap,
     /// `LON,LAT,RADIUS_DEG`: only the tiles reaching it are visited, so a
