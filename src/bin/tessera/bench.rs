@@ -13,8 +13,9 @@ pub(crate) enum BenchCommand {
 
 #[derive(Args)]
 pub(crate) struct AccuracyArgs {
-    /// Directory for ACCURACY.md and the plots.
-    #[arg(long, default_value = "docs")]
+    /// Directory for ACCURACY.md and the plots (no default: `docs` is the
+    /// tracked copy).
+    #[arg(long)]
     out: PathBuf,
     /// Largest N is 2^this (from 2^6).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(7..=24))]

@@ -26,8 +26,9 @@ pub(crate) struct LutTilingArgs {
     /// Which rep-tile.
     #[arg(value_enum)]
     tile: RepTile,
-    /// Directory to write `<tile>.rules.json` into.
-    #[arg(long, default_value = "luts")]
+    /// Directory to write `<tile>.rules.json` into (no default: `luts` is
+    /// the tracked copy the build embeds).
+    #[arg(long)]
     out_dir: PathBuf,
 }
 
@@ -49,8 +50,9 @@ pub(crate) struct LutBuildArgs {
     /// longer build.
     #[arg(long)]
     bins: Option<u16>,
-    /// Directory to write `<system>.lut` and `<system>.provenance.json` into.
-    #[arg(long, default_value = "luts")]
+    /// Directory to write `<system>.lut` and `<system>.provenance.json` into
+    /// (no default: `luts` is the tracked copy the build embeds).
+    #[arg(long)]
     out_dir: PathBuf,
 }
 
