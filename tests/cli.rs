@@ -467,3 +467,34 @@ fn usage_errors_exit_2_and_data_errors_exit_1() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.exr"));
 }
+
+/// `metrics` skips the O(N²) measures above `--pairs-up-to` (null, with a
+/// note) and keeps the O(N log N) ones.
+#[test]
+fn metrics_skip_the_quadratic_measures_of_large_sets() {
+    let dir = std::env::temp_dir().join(format!("tessera-pairs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("u.xyz");
+    let out = tessera(&["sphere", "-n", "500", "-o", file.to_str().unwrap()]);
+    assert!(out.status.success());
+    let json = |limit: &str| {
+        let out = tessera(&[
+            "metrics",
+            "sphere",
+            file.to_str().unwrap(),
+            "--json",
+            "--pairs-up-to",
+            limit,
+        ]);
+        assert!(out.status.success());
+        let value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (value, String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (all, quiet) = json("1000");
+    assert!(all["riesz1_normalized"].as_f64().unwrap() < -1.0 && quiet.is_empty());
+    let (cheap, note) = json("100");
+    assert!(cheap["riesz1_normalized"].is_null() && cheap["cap_discrepancy_l2"].is_null());
+    assert_eq!(cheap["separation"], all["separation"]);
+    assert!(note.contains("--pairs-up-to 100"), "{note}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

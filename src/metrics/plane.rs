@@ -523,6 +523,21 @@ pub struct PlaneReport {
 /// assert!(r.l2_star_discrepancy > 0.0 && r.l2_star_discrepancy < 0.1);
 /// ```
 pub fn plane_report(points: &[DVec2]) -> PlaneReport {
+    plane_report_up_to(points, usize::MAX)
+}
+
+/// [`plane_report`] with the three O(N²) measures (both discrepancies and
+/// the low-frequency power) only up to `pair_limit` points: NaN (JSON
+/// `null`) beyond it, so that large sets cost O(N log N).
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::plane::plane_report_up_to;
+/// let r = plane_report_up_to(&uniform_random_2d(256, 5), 100);
+/// assert!(r.l2_star_discrepancy.is_nan() && r.min_distance > 0.0);
+/// ```
+pub fn plane_report_up_to(points: &[DVec2], pair_limit: usize) -> PlaneReport {
+    let pairs = points.len() <= pair_limit;
     let distances = (points.len() >= 2).then(|| nn_distances(points));
     let (min_distance, mean_nn_distance) = match (&distances, points.len()) {
         (_, 0) => (f64::NAN, f64::NAN),
@@ -541,9 +556,21 @@ pub fn plane_report(points: &[DVec2]) -> PlaneReport {
         n: points.len(),
         min_distance,
         mean_nn_distance,
-        l2_star_discrepancy: l2_star_discrepancy(points),
-        centered_l2_discrepancy: centered_l2_discrepancy(points),
-        low_frequency_power: low_frequency_power(points),
+        l2_star_discrepancy: if pairs {
+            l2_star_discrepancy(points)
+        } else {
+            f64::NAN
+        },
+        centered_l2_discrepancy: if pairs {
+            centered_l2_discrepancy(points)
+        } else {
+            f64::NAN
+        },
+        low_frequency_power: if pairs {
+            low_frequency_power(points)
+        } else {
+            f64::NAN
+        },
     }
 }
 

@@ -387,7 +387,22 @@ pub struct SphereReport {
 /// assert!((r.mesh_ratio - 2.0 * r.covering_radius / r.separation).abs() < 1e-12);
 /// ```
 pub fn sphere_report(points: &[DVec3]) -> SphereReport {
+    sphere_report_up_to(points, usize::MAX)
+}
+
+/// [`sphere_report`] with the two O(N²) measures (cap discrepancy and
+/// energy) only up to `pair_limit` points: NaN (JSON `null`) beyond it,
+/// so that large sets cost O(N log N).
+///
+/// ```
+/// use tessera::baselines::spherical_fibonacci;
+/// use tessera::metrics::sphere::sphere_report_up_to;
+/// let r = sphere_report_up_to(&spherical_fibonacci(300), 100);
+/// assert!(r.riesz1_normalized.is_nan() && r.separation > 3.0);
+/// ```
+pub fn sphere_report_up_to(points: &[DVec3], pair_limit: usize) -> SphereReport {
     let n = points.len();
+    let pairs = n <= pair_limit;
     let nf = (n as f64).sqrt();
     let min_d = min_geodesic(points);
     let cover = covering_angle(points);
@@ -399,8 +414,16 @@ pub fn sphere_report(points: &[DVec3]) -> SphereReport {
     SphereReport {
         n,
         separation,
-        cap_discrepancy_l2: cap_discrepancy_l2(points),
-        riesz1_normalized: riesz1_normalized(points),
+        cap_discrepancy_l2: if pairs {
+            cap_discrepancy_l2(points)
+        } else {
+            f64::NAN
+        },
+        riesz1_normalized: if pairs {
+            riesz1_normalized(points)
+        } else {
+            f64::NAN
+        },
         covering_radius,
         mesh_ratio,
     }
