@@ -29,6 +29,7 @@ pub mod plot;
 pub mod polyomino;
 pub mod random;
 pub mod relax;
+pub mod request;
 mod sample;
 mod sampler;
 pub mod synth;

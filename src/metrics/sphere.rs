@@ -45,6 +45,21 @@ pub fn geodesic_distance(a: DVec3, b: DVec3) -> f64 {
     crate::voronoi::geodesic(a, b)
 }
 
+/// The index of the first point that is not a finite unit vector (to
+/// 1e-6): the points `tessera metrics sphere` refuses to measure.
+///
+/// ```
+/// use glam::DVec3;
+/// use tessera::metrics::sphere::first_non_unit;
+/// assert_eq!(first_non_unit(&[DVec3::X, DVec3::Y]), None);
+/// assert_eq!(first_non_unit(&[DVec3::X, DVec3::splat(1.0), DVec3::NAN]), Some(1));
+/// ```
+pub fn first_non_unit(points: &[DVec3]) -> Option<usize> {
+    points
+        .iter()
+        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
+}
+
 /// Index of the nearest other point of `points[i]` (requires N ≥ 2).
 fn nearest_other(tree: &Tree3, points: &[DVec3], i: usize) -> usize {
     let q = points[i].to_array();

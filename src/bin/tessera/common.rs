@@ -4,10 +4,8 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use tessera::density::{Density, Region};
-use tessera::engine::{Order, Sample};
-use tessera::tiling::TileSystem;
-use tessera::{engine, Error};
+use tessera::engine::Order;
+use tessera::Error;
 
 /// What every sampling command asks for: how many samples, and where to.
 #[derive(Args)]
@@ -33,23 +31,13 @@ pub(crate) struct RequestArgs {
 }
 
 impl RequestArgs {
-    /// The samples this request asks for from `system` under `density`.
-    pub(crate) fn generate<S, D>(
-        &self,
-        system: &S,
-        density: &D,
-    ) -> Result<Vec<Sample<S::Point>>, Error>
-    where
-        S: TileSystem,
-        S::Region: Region<Point = S::Point>,
-        D: Density<S::Region> + ?Sized,
-    {
-        let order = if self.unsorted {
+    /// `--unsorted` as an output order.
+    pub(crate) fn order(&self) -> Order {
+        if self.unsorted {
             Order::Unsorted
         } else {
             Order::Progressive
-        };
-        engine::generate_ordered(system, density, self.count, !self.expected, order)
+        }
     }
 }
 
@@ -83,10 +71,6 @@ pub(crate) enum Domain {
     Plane,
 }
 
-/// Uniform requests above this many samples stream one at a time (one
-/// thread, O(depth) memory) instead of being generated in parallel in memory.
-pub(crate) const STREAM_ABOVE: usize = 1 << 24;
-
 pub(crate) fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
     if path == Path::new("-") {
         return Ok(Box::new(std::io::BufWriter::new(std::io::stdout().lock())));
@@ -112,10 +96,7 @@ pub(crate) fn read_sphere_points(path: &Path) -> Result<Vec<glam::DVec3>, Error>
         .iter()
         .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
         .collect();
-    match points
-        .iter()
-        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
-    {
+    match tessera::metrics::sphere::first_non_unit(&points) {
         Some(bad) => Err(Error::File {
             path: path.into(),
             reason: format!("point {} is not a unit vector", bad + 1),

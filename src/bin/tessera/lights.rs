@@ -47,22 +47,17 @@ pub(crate) struct LightsArgs {
 /// `lights`: read the map's colour and importance in one decode, warn and
 /// refuse as `sphere --map` does, write the lights.
 pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
-    use tessera::lights::{read_rgb, LightOptions};
-    let path = &args.map;
+    use tessera::lights::LightOptions;
     let options = tessera::io::image::ReadOptions {
         channel: args.channel.clone(),
         strict: args.strict,
         ..Default::default()
     };
-    let (rgb, raster) = read_rgb(path, &options)?;
-    let name = path.display();
-    if raster.bad_pixels > 0 || rgb.bad_samples > 0 {
-        eprintln!(
-            "tessera: warning: {name}: {} pixel(s) and {} colour sample(s) negative, NaN or infinite, treated as 0 (--strict refuses them)",
-            raster.bad_pixels, rgb.bad_samples
-        );
+    let (map, rgb, warnings) =
+        tessera::request::open_light_map(&args.map, &options, args.up.into())?;
+    for warning in warnings {
+        eprintln!("tessera: warning: {warning}");
     }
-    let map = crate::sphere::env_map(path, raster, args.up)?;
     let options = LightOptions {
         rgb: Some(&rgb),
         exponent: args.exponent,

@@ -4,10 +4,7 @@ use crate::common::*;
 use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use std::io::Write;
-use tessera::density::plane::Shifted;
-use tessera::density::Density;
-use tessera::tiling::plane::PlaneRegion;
-use tessera::{engine, Error};
+use tessera::Error;
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum PlaneKind {
@@ -47,83 +44,32 @@ pub(crate) struct PlaneArgs {
 }
 
 pub(crate) fn plane(args: PlaneArgs) -> Result<(), Error> {
-    use tessera::lut::PlaneSystem;
-    use tessera::tiling::plane::PlaneTiling;
-    let polyomino = |system| PlaneTiling::new(tessera::lut::plane_lut(system));
-    match args.system {
-        PlaneKind::Penrose => {
-            plane_with(&tessera::tiling::penrose::PenroseTiling::default(), &args)
-        }
-        PlaneKind::Ghexomino => plane_with(&polyomino(PlaneSystem::Ghexomino), &args),
-        PlaneKind::Ppentomino => plane_with(&polyomino(PlaneSystem::Ppentomino), &args),
-    }
-}
-
-pub(crate) fn plane_with<S>(tiling: &S, args: &PlaneArgs) -> Result<(), Error>
-where
-    S: tessera::tiling::TileSystem<
-        Point = glam::DVec2,
-        Region = tessera::tiling::plane::PlaneRegion,
-    >,
-{
+    use tessera::request::{PlaneKind as Kind, PlaneRequest};
     let format: tessera::io::points::PlaneFormat = args.format.parse()?;
     let density = tessera::density::plane::parse(&args.density, args.invert)?;
-    let rect = args
-        .domain
-        .as_deref()
-        .map(tessera::density::rectangle::Rectangle::parse)
-        .transpose()?;
-    let count = args.request.count;
-    // the pdf per unit area of the domain: the density's unit square is
-    // stretched over the rectangle
-    let (lo, size) = rect.map_or((glam::DVec2::ZERO, glam::DVec2::ONE), |r| {
-        (r.lo, r.hi - r.lo)
-    });
-    let pdf = |q: glam::DVec2| density.value((q - lo) / size) / (density.mean() * size.x * size.y);
-    let mut out = create(&args.request.output)?;
-    let written = match engine::stream(tiling, count) {
-        // large uniform requests stream: memory stays O(depth)
-        Some(stream)
-            if density.constant().is_some()
-                && rect.is_none()
-                && args.request.seed.is_none()
-                && count > STREAM_ABOVE =>
-        {
-            tessera::io::points::write_plane(&mut out, stream.map(|s| s.position), format, pdf)
-        }
-        _ => {
-            let restricted = rect.map(|rect| rect.restrict(&*density));
-            let square: &(dyn Density<PlaneRegion> + Sync) = match &restricted {
-                Some(r) => r,
-                None => &*density,
-            };
-            let in_square: Vec<glam::DVec2> = match args.request.seed {
-                Some(seed) => {
-                    let shifted = Shifted::new(square, seed);
-                    let samples = args.request.generate(tiling, &shifted)?;
-                    samples
-                        .iter()
-                        .map(|s| shifted.to_world(s.position))
-                        .collect()
-                }
-                None => args
-                    .request
-                    .generate(tiling, square)?
-                    .iter()
-                    .map(|s| s.position)
-                    .collect(),
-            };
-            let points: Vec<glam::DVec2> = match rect {
-                Some(rect) => in_square
-                    .into_iter()
-                    .map(|p: glam::DVec2| rect.to_world(p))
-                    .collect(),
-                None => in_square,
-            };
-            tessera::io::points::write_plane(&mut out, points, format, pdf)
-        }
+    let system = match args.system {
+        PlaneKind::Penrose => Kind::Penrose,
+        PlaneKind::Ghexomino => Kind::Ghexomino,
+        PlaneKind::Ppentomino => Kind::Ppentomino,
     };
-    written
-        .and_then(|()| out.flush())
-        .map_err(io_error(&args.request.output))
+    let request = PlaneRequest {
+        system,
+        count: args.request.count,
+        expected: args.request.expected,
+        order: args.request.order(),
+        seed: args.request.seed,
+        domain: args
+            .domain
+            .as_deref()
+            .map(tessera::density::rectangle::Rectangle::parse)
+            .transpose()?,
+    };
+    let pdf = request.pdf(&*density);
+    let output = &args.request.output;
+    request.with_points(&*density, |points| {
+        let mut out = create(output)?;
+        tessera::io::points::write_plane(&mut out, points, format, &pdf)
+            .and_then(|()| out.flush())
+            .map_err(io_error(output))
+    })?
 }

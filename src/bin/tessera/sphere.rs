@@ -5,11 +5,9 @@ use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use tessera::density::sphere::{Cap, Rotated};
-use tessera::density::Density;
+use tessera::density::sphere::Cap;
 use tessera::io::points::SphereFormat;
-use tessera::tiling::sphere::{SphereRegion, SphereTiling};
-use tessera::{engine, Error};
+use tessera::Error;
 
 #[derive(Args)]
 pub(crate) struct SphereArgs {
@@ -71,126 +69,56 @@ pub(crate) enum UpAxis {
 }
 
 pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
+    use tessera::request::{SphereDensity, SphereRequest};
     let format: SphereFormat = args.format.parse()?;
-    if let Some(path) = &args.map {
-        return sphere_map(&args, path, format);
+    let density = match &args.map {
+        Some(path) => SphereDensity::Map(open_map(path, &args)?),
+        None => SphereDensity::parse(&args.density)?,
+    };
+    let request = SphereRequest {
+        count: args.request.count,
+        expected: args.request.expected,
+        order: args.request.order(),
+        seed: args.request.seed,
+        within: args.within.as_deref().map(Cap::window).transpose()?,
+        relax: args.relax,
+    };
+    let pdf = density.pdf();
+    let output = &args.request.output;
+    let write = |points: &mut dyn ExactSizeIterator<Item = glam::DVec3>| {
+        let mut out = create(output)?;
+        tessera::io::points::write_sphere(&mut out, points, format, &pdf)
+            .and_then(|()| out.flush())
+            .map_err(io_error(output))
+    };
+    if args.report && request.within.is_none() {
+        let points = request.points(&density)?;
+        if let (SphereDensity::Map(map), Some(path)) = (&density, &args.map) {
+            eprintln!(
+                "tessera: {}: integral {} (value x sr)",
+                path.display(),
+                map.integral()
+            );
+        }
+        print_report(&points);
+        write(&mut points.into_iter())
+    } else {
+        request.with_points(&density, write)?
     }
-    let density = tessera::density::region::parse_all(&args.density)?;
-    let tiling = SphereTiling::default();
-    let pdf = |p| engine::pdf(&tiling, &*density, p);
-    let Some(window) = args.within.as_deref().map(Cap::window).transpose()? else {
-        return match args.request.seed {
-            Some(seed) => {
-                let rotated = Rotated::new(&*density, seed);
-                write_samples(&args, &rotated, |p| rotated.to_world(p), format, pdf)
-            }
-            None => write_samples(&args, &*density, |p| p, format, pdf),
-        };
-    };
-    // a window visits only the tiles reaching it
-    let near = engine::collect_within(&tiling, &*density, args.request.count as f64, &|r| {
-        window.reaches(r)
-    });
-    let inside = near
-        .iter()
-        .map(|s| s.position)
-        .filter(|&p| window.contains(p));
-    let points: Vec<glam::DVec3> = inside.collect();
-    let mut out = create(&args.request.output)?;
-    tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        .and_then(|()| out.flush())
-        .map_err(io_error(&args.request.output))
 }
 
-/// The samples of `density` (in its sampling frame, which `to_world` maps
-/// to the world) written as `format`; large uniform requests stream in
-/// O(depth) memory.
-fn write_samples<D>(
-    args: &SphereArgs,
-    density: &D,
-    to_world: impl Fn(glam::DVec3) -> glam::DVec3,
-    format: SphereFormat,
-    pdf: impl Fn(glam::DVec3) -> f64,
-) -> Result<(), Error>
-where
-    D: Density<SphereRegion> + ?Sized,
-{
-    let tiling = SphereTiling::default();
-    let mut out = create(&args.request.output)?;
-    let written = match engine::stream(&tiling, args.request.count) {
-        Some(stream)
-            if density.constant().is_some()
-                && args.request.count > STREAM_ABOVE
-                && args.relax == 0 =>
-        {
-            let points = stream.map(|s| to_world(s.position));
-            tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        }
-        _ => {
-            let samples = args.request.generate(&tiling, density)?;
-            let points = relaxed(samples, density, args.relax)?;
-            let points: Vec<glam::DVec3> = points.into_iter().map(to_world).collect();
-            if args.report {
-                print_report(&points);
-            }
-            tessera::io::points::write_sphere(&mut out, points, format, pdf)
-        }
-    };
-    written
-        .and_then(|()| out.flush())
-        .map_err(io_error(&args.request.output))
-}
-
-pub(crate) fn sphere_map(
-    args: &SphereArgs,
-    path: &Path,
-    format: SphereFormat,
-) -> Result<(), Error> {
+/// The `--map` of a request, its warnings printed.
+fn open_map(path: &Path, args: &SphereArgs) -> Result<tessera::density::envmap::EnvMap, Error> {
     let options = tessera::io::image::ReadOptions {
         channel: args.channel.clone(),
         strict: args.strict,
         ..Default::default()
     };
-    let raster = tessera::io::image::read_raster(path, &options)?;
-    let name = path.display();
-    if raster.bad_pixels > 0 {
-        eprintln!(
-            "tessera: warning: {name}: {} negative, NaN or infinite pixel(s) treated as 0 (--strict refuses NaN, infinities and negatives beyond codec noise)",
-            raster.bad_pixels
-        );
+    let (map, warnings) = tessera::request::open_map(path, &options, args.up.into())?;
+    for warning in warnings {
+        eprintln!("tessera: warning: {warning}");
     }
-    let map = env_map(path, raster, args.up)?;
-    let map = match args.request.seed {
-        Some(seed) => map.with_seed(seed),
-        None => map,
-    };
-    let tiling = SphereTiling::default();
-    let samples = args.request.generate(&tiling, &map)?;
-    let points = relaxed(samples, &map, args.relax)?;
-    let points: Vec<glam::DVec3> = points.into_iter().map(|p| map.to_world(p)).collect();
-    if args.report {
-        eprintln!("tessera: {name}: integral {} (value x sr)", map.integral());
-        print_report(&points);
-    }
-    let mut out = create(&args.request.output)?;
-    tessera::io::points::write_sphere(&mut out, points.iter().copied(), format, |p| map.pdf(p))
-        .and_then(|()| out.flush())
-        .map_err(io_error(&args.request.output))
-}
-
-/// The positions of `samples` after `iterations` Lloyd iterations under
-/// `density` (in its sampling frame).
-fn relaxed<D>(
-    samples: Vec<tessera::Sample<glam::DVec3>>,
-    density: &D,
-    iterations: usize,
-) -> Result<Vec<glam::DVec3>, Error>
-where
-    D: Density<SphereRegion> + ?Sized,
-{
-    let mut points: Vec<glam::DVec3> = samples.into_iter().map(|s| s.position).collect();
-    tessera::relax::relax(&mut points, density, iterations)?;
-    Ok(points)
+    Ok(map)
 }
 
 /// Separation, covering radius and mesh ratio of a point set (the O(N log N)
@@ -206,28 +134,11 @@ pub(crate) fn print_report(points: &[glam::DVec3]) {
     );
 }
 
-/// The environment map of a raster read from `path`, warning when it is
-/// not 2:1 (shared by `sphere --map` and `lights`).
-pub(crate) fn env_map(
-    path: &Path,
-    raster: tessera::io::image::Raster,
-    up: UpAxis,
-) -> Result<tessera::density::envmap::EnvMap, Error> {
-    use tessera::density::envmap::{EnvMap, Up};
-    if raster.width != 2 * raster.height {
-        eprintln!(
-            "tessera: warning: {}: {}x{} is not a 2:1 lat-long map; using it as one",
-            path.display(),
-            raster.width,
-            raster.height
-        );
+impl From<UpAxis> for tessera::density::envmap::Up {
+    fn from(up: UpAxis) -> Self {
+        match up {
+            UpAxis::Z => tessera::density::envmap::Up::Z,
+            UpAxis::Y => tessera::density::envmap::Up::Y,
+        }
     }
-    let up = match up {
-        UpAxis::Z => Up::Z,
-        UpAxis::Y => Up::Y,
-    };
-    EnvMap::new(raster, up).map_err(|e| Error::File {
-        path: path.into(),
-        reason: e.to_string(),
-    })
 }

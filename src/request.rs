@@ -1,0 +1,578 @@
+//! The sampling commands' requests as library calls.
+//!
+//! `tessera sphere`, `tessera plane` and `tessera lights` take a density
+//! (region strings, a map, an image), a count and a few options (exact or
+//! expected count, order, seed, window, relaxation, domain). The types here
+//! carry those requests and run them, and the command line and the Python
+//! package (`python/`) both call them: the same request gives the same
+//! points, bit for bit, from either.
+//!
+//! ```
+//! use tessera::request::{SphereDensity, SphereRequest};
+//! let density = SphereDensity::parse(&["cap:0,90,20,10"]).unwrap();
+//! let request = SphereRequest { count: 1000, seed: Some(3), ..Default::default() };
+//! let points = request.points(&density).unwrap();
+//! assert_eq!(points.len(), 1000);
+//! let pdf = density.pdf();
+//! assert!(points.iter().all(|&p| pdf(p) > 0.0));
+//! ```
+
+use crate::density::envmap::{EnvMap, Up};
+use crate::density::plane::Shifted;
+use crate::density::rectangle::Rectangle;
+use crate::density::sphere::{Cap, Rotated};
+use crate::density::{Density, Uniform};
+use crate::engine::{self, Order, Sample};
+use crate::io::image::{read_raster, Raster, ReadOptions};
+use crate::lights::RgbMap;
+use crate::tiling::plane::{PlaneRegion, PlaneTiling};
+use crate::tiling::sphere::{SphereRegion, SphereTiling};
+use crate::tiling::TileSystem;
+use crate::Error;
+use glam::{DVec2, DVec3};
+use std::path::Path;
+
+/// Uniform requests above this many samples stream one at a time (one
+/// thread, O(depth) memory) in [`SphereRequest::with_points`] and
+/// [`PlaneRequest::with_points`], instead of being generated in parallel
+/// in memory. The points are the same either way.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::request::STREAM_ABOVE, 1 << 24);
+/// ```
+pub const STREAM_ABOVE: usize = 1 << 24;
+
+/// What a sphere request samples: the command line's region strings
+/// (`--density`) or a lat-long environment map (`--map`).
+///
+/// # Example
+/// ```
+/// use tessera::request::SphereDensity;
+/// let d = SphereDensity::parse(&["uniform"]).unwrap();
+/// let pdf = d.pdf();
+/// assert!((pdf(glam::DVec3::X) * 4.0 * std::f64::consts::PI - 1.0).abs() < 1e-15);
+/// assert!(SphereDensity::parse(&["cap:0,0"]).is_err());
+/// ```
+pub enum SphereDensity {
+    /// `uniform`, a cap or a combination of caps and polygons (see
+    /// [`crate::density::region::parse_all`]).
+    Regions(Box<dyn Density<SphereRegion> + Send>),
+    /// A lat-long map, luminance per unit solid angle.
+    Map(EnvMap),
+}
+
+impl SphereDensity {
+    /// Parses `--density` values as `tessera sphere` does
+    /// ([`crate::density::region::parse_all`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::request::SphereDensity;
+    /// assert!(SphereDensity::parse(&["cap:0,0,5,3", "polygon:0 0,10 0,10 10;4"]).is_ok());
+    /// ```
+    pub fn parse<S: AsRef<str>>(specs: &[S]) -> Result<Self, Error> {
+        crate::density::region::parse_all(specs).map(SphereDensity::Regions)
+    }
+
+    /// The pdf per steradian the samples follow, as a function of a world
+    /// direction (what `tessera sphere --format csv` writes). With
+    /// [`SphereRequest::relax`] it is the target density's, and with
+    /// [`SphereRequest::within`] that of the whole request. Directions need
+    /// not be normalised.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::request::SphereDensity;
+    /// let d = SphereDensity::parse(&["cap:0,90,10,100"]).unwrap();
+    /// let pdf = d.pdf();
+    /// assert!((pdf(glam::DVec3::Z) / pdf(-glam::DVec3::Z) - 100.0).abs() < 1e-9);
+    /// ```
+    pub fn pdf(&self) -> impl Fn(DVec3) -> f64 + Sync + '_ {
+        let tiling = SphereTiling::default();
+        move |p| match self {
+            SphereDensity::Regions(density) => engine::pdf(&tiling, &**density, p),
+            SphereDensity::Map(map) => map.pdf(p),
+        }
+    }
+}
+
+/// The options of `tessera sphere` besides the density: `-n`,
+/// `--expected`, `--unsorted`, `--seed`, `--within` and `--relax`.
+///
+/// # Example
+/// ```
+/// use tessera::{engine::Order, request::{SphereDensity, SphereRequest}};
+/// let uniform = SphereDensity::parse(&["uniform"]).unwrap();
+/// let request = SphereRequest { count: 500, order: Order::Unsorted, ..Default::default() };
+/// assert_eq!(request.points(&uniform).unwrap().len(), 500);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SphereRequest {
+    /// Number of samples (exact unless `expected`).
+    pub count: usize,
+    /// Skip the exactness pass: the natural count near `count`.
+    pub expected: bool,
+    /// Progressive (every prefix well spread) or the cheapest order.
+    pub order: Order,
+    /// Sample in a uniformly random frame drawn from this seed (estimates
+    /// averaged over seeds are unbiased); without it the set is
+    /// deterministic.
+    pub seed: Option<u64>,
+    /// Keep only the samples of the request inside this cap, visiting only
+    /// the tiles reaching it (see [`engine::collect_within`]): the count is
+    /// the expected one, and `expected` and `order` are not used. Not with
+    /// a map, a seed or relaxation.
+    pub within: Option<Cap>,
+    /// Density-weighted Lloyd iterations run on the set
+    /// ([`crate::relax::relax`]).
+    pub relax: usize,
+}
+
+impl SphereRequest {
+    /// The request's world directions, in its order.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::sphere::Cap, request::{SphereDensity, SphereRequest}};
+    /// let uniform = SphereDensity::parse(&["uniform"]).unwrap();
+    /// let window = Cap::window("0,0,10").unwrap();
+    /// let request = SphereRequest { count: 100_000, within: Some(window), ..Default::default() };
+    /// let near = request.points(&uniform).unwrap();
+    /// assert!(near.iter().all(|&p| window.contains(p)));
+    /// // a 10-degree cap holds 0.76 % of the sphere
+    /// assert!((700..820).contains(&near.len()), "{}", near.len());
+    /// ```
+    pub fn points(&self, density: &SphereDensity) -> Result<Vec<DVec3>, Error> {
+        let tiling = SphereTiling::default();
+        if let Some(window) = &self.within {
+            let refuse = |what: &str| {
+                Err(Error::Request(format!(
+                    "a window (within) cannot be combined with {what}"
+                )))
+            };
+            let SphereDensity::Regions(density) = density else {
+                return refuse("a map");
+            };
+            if self.seed.is_some() {
+                return refuse("a seed");
+            }
+            if self.relax > 0 {
+                return refuse("relaxation");
+            }
+            // a window visits only the tiles reaching it
+            let near = engine::collect_within(&tiling, &**density, self.count as f64, &|r| {
+                window.reaches(r)
+            });
+            return Ok(near
+                .into_iter()
+                .map(|s| s.position)
+                .filter(|&p| window.contains(p))
+                .collect());
+        }
+        match (density, self.seed) {
+            (SphereDensity::Map(map), seed) => {
+                let map = match seed {
+                    Some(seed) => map.with_seed(seed),
+                    None => map.clone(),
+                };
+                let samples = self.samples(&tiling, &map)?;
+                self.finish(samples, &map, |p| map.to_world(p))
+            }
+            (SphereDensity::Regions(density), Some(seed)) => {
+                let rotated = Rotated::new(&**density, seed);
+                let samples = self.samples(&tiling, &rotated)?;
+                self.finish(samples, &rotated, |p| rotated.to_world(p))
+            }
+            (SphereDensity::Regions(density), None) => {
+                let samples = self.samples(&tiling, &**density)?;
+                self.finish(samples, &**density, |p| p)
+            }
+        }
+    }
+
+    /// [`SphereRequest::points`] handed to `sink` as an exact-size
+    /// iterator: a uniform request of more than [`STREAM_ABOVE`] samples
+    /// (without window or relaxation) streams in O(depth) memory, others
+    /// are generated in memory first. This is how `tessera sphere` writes.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::request::{SphereDensity, SphereRequest};
+    /// let uniform = SphereDensity::parse(&["uniform"]).unwrap();
+    /// let request = SphereRequest { count: 1000, ..Default::default() };
+    /// let streamed: Vec<_> = request.with_points(&uniform, |points| points.collect()).unwrap();
+    /// assert_eq!(streamed, request.points(&uniform).unwrap());
+    /// ```
+    pub fn with_points<R>(
+        &self,
+        density: &SphereDensity,
+        sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec3>) -> R,
+    ) -> Result<R, Error> {
+        if let SphereDensity::Regions(d) = density {
+            let tiling = SphereTiling::default();
+            let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
+            match engine::stream(&tiling, self.count) {
+                Some(stream) if uniform && self.count > STREAM_ABOVE => {
+                    // the frame of `Rotated::new(density, seed)`
+                    let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
+                    let mut points = stream.map(|s| match &frame {
+                        Some(frame) => frame.to_world(s.position),
+                        None => s.position,
+                    });
+                    return Ok(sink(&mut points));
+                }
+                _ => {}
+            }
+        }
+        let points = self.points(density)?;
+        Ok(sink(&mut points.into_iter()))
+    }
+
+    fn samples<D>(&self, tiling: &SphereTiling, density: &D) -> Result<Vec<Sample<DVec3>>, Error>
+    where
+        D: Density<SphereRegion> + ?Sized,
+    {
+        engine::generate_ordered(tiling, density, self.count, !self.expected, self.order)
+    }
+
+    /// The positions of `samples` (in `density`'s sampling frame), relaxed,
+    /// then mapped to the world.
+    fn finish<D>(
+        &self,
+        samples: Vec<Sample<DVec3>>,
+        density: &D,
+        to_world: impl Fn(DVec3) -> DVec3,
+    ) -> Result<Vec<DVec3>, Error>
+    where
+        D: Density<SphereRegion> + ?Sized,
+    {
+        let mut points: Vec<DVec3> = samples.into_iter().map(|s| s.position).collect();
+        if self.relax > 0 {
+            crate::relax::relax(&mut points, density, self.relax)?;
+        }
+        Ok(points.into_iter().map(to_world).collect())
+    }
+}
+
+/// A lat-long map read from `path` as `tessera sphere --map` reads it, with
+/// the warnings it prints (see [`map_from_raster`]). Errors name the file.
+///
+/// # Example
+/// ```
+/// use tessera::{density::envmap::Up, request::open_map};
+/// let dir = std::env::temp_dir().join(format!("tessera-doc-open-map-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let path = dir.join("wide.exr");
+/// exr::prelude::write_rgb_file(&path, 3, 1, |x, _| (x as f32, 1.0f32, 0.0f32)).unwrap();
+/// let (map, warnings) = open_map(&path, &Default::default(), Up::Z).unwrap();
+/// assert_eq!((map.width(), map.height()), (3, 1));
+/// assert!(warnings[0].contains("not a 2:1"));
+/// assert!(open_map(&dir.join("missing.exr"), &Default::default(), Up::Z).is_err());
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn open_map(
+    path: &Path,
+    options: &ReadOptions,
+    up: Up,
+) -> Result<(EnvMap, Vec<String>), Error> {
+    let raster = read_raster(path, options)?;
+    let mut warnings = Vec::new();
+    if raster.bad_pixels > 0 {
+        warnings.push(format!(
+            "{}: {} negative, NaN or infinite pixel(s) treated as 0 (a strict read refuses NaN, infinities and negatives beyond codec noise)",
+            path.display(),
+            raster.bad_pixels
+        ));
+    }
+    let (map, more) = map_from_raster(path, raster, up)?;
+    warnings.extend(more);
+    Ok((map, warnings))
+}
+
+/// The environment map of a raster read from (or, for data in memory,
+/// named) `name`, and the warning `tessera sphere --map` and `tessera
+/// lights` print when it is not 2:1 (it is used as a lat-long map all the
+/// same). Errors name `name`.
+///
+/// # Example
+/// ```
+/// use tessera::{density::envmap::Up, io::image::Raster, request::map_from_raster};
+/// let raster = Raster::from_values("mem", 4, 2, vec![1.0; 8], false).unwrap();
+/// let (map, warnings) = map_from_raster("mem".as_ref(), raster, Up::Y).unwrap();
+/// assert!(warnings.is_empty() && map.up() == Up::Y);
+/// ```
+pub fn map_from_raster(
+    name: &Path,
+    raster: Raster,
+    up: Up,
+) -> Result<(EnvMap, Vec<String>), Error> {
+    let mut warnings = Vec::new();
+    if raster.width != 2 * raster.height {
+        warnings.push(format!(
+            "{}: {}x{} is not a 2:1 lat-long map; using it as one",
+            name.display(),
+            raster.width,
+            raster.height
+        ));
+    }
+    let map = EnvMap::new(raster, up).map_err(|e| Error::File {
+        path: name.into(),
+        reason: e.to_string(),
+    })?;
+    Ok((map, warnings))
+}
+
+/// A map file's importance and colour as `tessera lights` reads them
+/// ([`crate::lights::read_rgb`]), its environment map and the warnings it
+/// prints (bad samples zeroed, a map that is not 2:1).
+///
+/// # Example
+/// ```
+/// use tessera::{density::envmap::Up, request::open_light_map};
+/// let dir = std::env::temp_dir().join(format!("tessera-doc-open-light-map-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let path = dir.join("sky.exr");
+/// exr::prelude::write_rgb_file(&path, 4, 2, |x, _| (x as f32, 1.0f32, 0.5f32)).unwrap();
+/// let (map, rgb, warnings) = open_light_map(&path, &Default::default(), Up::Z).unwrap();
+/// assert_eq!((map.width(), rgb.rgb.len(), warnings.len()), (4, 8, 0));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn open_light_map(
+    path: &Path,
+    options: &ReadOptions,
+    up: Up,
+) -> Result<(EnvMap, RgbMap, Vec<String>), Error> {
+    let (rgb, raster) = crate::lights::read_rgb(path, options)?;
+    let mut warnings = Vec::new();
+    if raster.bad_pixels > 0 || rgb.bad_samples > 0 {
+        warnings.push(format!(
+            "{}: {} pixel(s) and {} colour sample(s) negative, NaN or infinite, treated as 0 (a strict read refuses them)",
+            path.display(),
+            raster.bad_pixels,
+            rgb.bad_samples
+        ));
+    }
+    let (map, more) = map_from_raster(path, raster, up)?;
+    warnings.extend(more);
+    Ok((map, rgb, warnings))
+}
+
+/// The planar tile systems of `tessera plane --system`.
+///
+/// # Example
+/// ```
+/// use tessera::request::PlaneKind;
+/// assert_eq!("ppentomino".parse::<PlaneKind>().unwrap(), PlaneKind::Ppentomino);
+/// assert!("hexagon".parse::<PlaneKind>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneKind {
+    /// Penrose: six tile types, scale 1/phi per level.
+    Penrose,
+    /// G-hexomino, 81-rep.
+    Ghexomino,
+    /// P-pentomino, 4-rep.
+    Ppentomino,
+}
+
+impl std::str::FromStr for PlaneKind {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        match s {
+            "penrose" => Ok(PlaneKind::Penrose),
+            "ghexomino" => Ok(PlaneKind::Ghexomino),
+            "ppentomino" => Ok(PlaneKind::Ppentomino),
+            other => Err(Error::Request(format!(
+                "unknown planar system '{other}'; expected penrose, ghexomino or ppentomino"
+            ))),
+        }
+    }
+}
+
+/// The options of `tessera plane` besides the density: `--system`, `-n`,
+/// `--expected`, `--unsorted`, `--seed` and `--domain`.
+///
+/// # Example
+/// ```
+/// use tessera::density::{plane::Ramp, rectangle::Rectangle};
+/// use tessera::request::{PlaneKind, PlaneRequest};
+/// let mut request = PlaneRequest::new(PlaneKind::Penrose, 400);
+/// request.domain = Some(Rectangle::parse("0,0,2,1").unwrap());
+/// let points = request.points(&Ramp).unwrap();
+/// assert_eq!(points.len(), 400);
+/// assert!(points.iter().all(|p| p.x < 2.0 && p.y < 1.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneRequest {
+    /// The tile system.
+    pub system: PlaneKind,
+    /// Number of samples (exact unless `expected`).
+    pub count: usize,
+    /// Skip the exactness pass: the natural count near `count`.
+    pub expected: bool,
+    /// Progressive (every prefix well spread) or the cheapest order.
+    pub order: Order,
+    /// Sample under a uniformly random toroidal shift drawn from this seed.
+    pub seed: Option<u64>,
+    /// Sample this rectangle instead of the unit square: the density's
+    /// unit square stretched over it.
+    pub domain: Option<Rectangle>,
+}
+
+impl PlaneRequest {
+    /// `count` samples of `system` on the unit square, exact, progressive,
+    /// without seed.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::Uniform, request::{PlaneKind, PlaneRequest}};
+    /// let points = PlaneRequest::new(PlaneKind::Ghexomino, 81).points(&Uniform).unwrap();
+    /// assert_eq!(points.len(), 81);
+    /// ```
+    pub fn new(system: PlaneKind, count: usize) -> Self {
+        PlaneRequest {
+            system,
+            count,
+            expected: false,
+            order: Order::Progressive,
+            seed: None,
+            domain: None,
+        }
+    }
+
+    /// The request's points (in the domain), in its order. `density` is
+    /// given on the unit square, as [`crate::density::plane::parse`]
+    /// returns it.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::plane::Ramp, request::{PlaneKind, PlaneRequest}};
+    /// let mut request = PlaneRequest::new(PlaneKind::Ppentomino, 2000);
+    /// request.seed = Some(4);
+    /// let points = request.points(&Ramp).unwrap();
+    /// assert!(points.iter().filter(|p| p.x >= 0.5).count() > 1400);
+    /// ```
+    pub fn points(&self, density: &dyn Density<PlaneRegion>) -> Result<Vec<DVec2>, Error> {
+        match self.system {
+            PlaneKind::Penrose => {
+                self.points_with(&crate::tiling::penrose::PenroseTiling::default(), density)
+            }
+            PlaneKind::Ghexomino => self.points_with(&PlaneTiling::ghexomino(), density),
+            PlaneKind::Ppentomino => self.points_with(&PlaneTiling::ppentomino(), density),
+        }
+    }
+
+    /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
+    /// a uniform request of more than [`STREAM_ABOVE`] samples on the unit
+    /// square without seed streams in O(depth) memory. This is how
+    /// `tessera plane` writes.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{density::Uniform, request::{PlaneKind, PlaneRequest}};
+    /// let request = PlaneRequest::new(PlaneKind::Ppentomino, 300);
+    /// let n = request.with_points(&Uniform, |points| points.len()).unwrap();
+    /// assert_eq!(n, 300);
+    /// ```
+    pub fn with_points<R>(
+        &self,
+        density: &dyn Density<PlaneRegion>,
+        sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec2>) -> R,
+    ) -> Result<R, Error> {
+        let streams = density.constant().is_some()
+            && self.domain.is_none()
+            && self.seed.is_none()
+            && self.count > STREAM_ABOVE;
+        if streams {
+            let penrose;
+            let polyomino;
+            let tiling: &dyn StreamSource = match self.system {
+                PlaneKind::Penrose => {
+                    penrose = crate::tiling::penrose::PenroseTiling::default();
+                    &penrose
+                }
+                PlaneKind::Ghexomino => {
+                    polyomino = PlaneTiling::ghexomino();
+                    &polyomino
+                }
+                PlaneKind::Ppentomino => {
+                    polyomino = PlaneTiling::ppentomino();
+                    &polyomino
+                }
+            };
+            let stream = tiling.stream(self.count);
+            if let Some(mut points) = stream {
+                return Ok(sink(&mut *points));
+            }
+        }
+        let points = self.points(density)?;
+        Ok(sink(&mut points.into_iter()))
+    }
+
+    /// The pdf per unit area of the domain at a point of it, for samples
+    /// of `density` (given on the unit square, which the domain stretches):
+    /// what `tessera plane --format csv` writes.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{rectangle::Rectangle, Uniform};
+    /// use tessera::request::{PlaneKind, PlaneRequest};
+    /// let mut request = PlaneRequest::new(PlaneKind::Ghexomino, 10);
+    /// request.domain = Some(Rectangle::parse("0,0,4,2").unwrap());
+    /// assert_eq!(request.pdf(&Uniform)(glam::DVec2::new(1.0, 1.0)), 1.0 / 8.0);
+    /// ```
+    pub fn pdf<'a>(&self, density: &'a dyn Density<PlaneRegion>) -> impl Fn(DVec2) -> f64 + 'a {
+        // the density's unit square is stretched over the rectangle
+        let (lo, size) = self
+            .domain
+            .map_or((DVec2::ZERO, DVec2::ONE), |r| (r.lo, r.hi - r.lo));
+        let scale = density.mean() * size.x * size.y;
+        move |q: DVec2| density.value((q - lo) / size) / scale
+    }
+
+    fn points_with<S>(
+        &self,
+        tiling: &S,
+        density: &dyn Density<PlaneRegion>,
+    ) -> Result<Vec<DVec2>, Error>
+    where
+        S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+    {
+        let restricted = self.domain.map(|rect| rect.restrict(density));
+        let square: &dyn Density<PlaneRegion> = match &restricted {
+            Some(r) => r,
+            None => density,
+        };
+        let exact = !self.expected;
+        let in_square: Vec<DVec2> = match self.seed {
+            Some(seed) => {
+                let shifted = Shifted::new(square, seed);
+                engine::generate_ordered(tiling, &shifted, self.count, exact, self.order)?
+                    .iter()
+                    .map(|s| shifted.to_world(s.position))
+                    .collect()
+            }
+            None => engine::generate_ordered(tiling, square, self.count, exact, self.order)?
+                .iter()
+                .map(|s| s.position)
+                .collect(),
+        };
+        Ok(match self.domain {
+            Some(rect) => in_square.into_iter().map(|p| rect.to_world(p)).collect(),
+            None => in_square,
+        })
+    }
+}
+
+/// A planar tiling's uniform stream, behind one type for every system.
+trait StreamSource {
+    fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>>;
+}
+
+impl<S: TileSystem<Point = DVec2>> StreamSource for S {
+    fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>> {
+        let stream = engine::stream(self, count)?;
+        Some(Box::new(stream.map(|s| s.position)))
+    }
+}
