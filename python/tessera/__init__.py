@@ -1,0 +1,447 @@
+"""tessera: hierarchical importance sampling with blue-noise properties.
+
+Numpy arrays in and out of the tessera library (a Rust crate): points on the
+unit sphere (HEALPix faces tiled by P-pentominoes) or in the unit square
+(Penrose, G-hexomino, P-pentomino tilings), following a density, well spread
+at every prefix. Every option means what the ``tessera`` command line's
+option of the same name means, and the same request gives the same points,
+bit for bit.
+
+>>> import tessera
+>>> points = tessera.sphere(1000, "cap:2.35,48.85,10,50")
+>>> points.shape
+(1000, 3)
+>>> lon, lat = tessera.lonlat(points)
+>>> bool(((lon >= -180) & (lon < 180)).all())
+True
+
+Errors in the request raise ``ValueError`` with the library's message, and
+files that cannot be read ``OSError`` (``FileNotFoundError`` when missing).
+The GIL is released while sampling.
+"""
+
+import operator
+import os
+import warnings as _warnings
+
+import numpy as np
+
+from . import _tessera
+from . import metrics
+
+__all__ = [
+    "sphere",
+    "pdf",
+    "plane",
+    "lights",
+    "lonlat",
+    "from_lonlat",
+    "stream",
+    "metrics",
+]
+
+__version__ = _tessera.__version__
+
+
+def _count(n, name="n"):
+    try:
+        n = operator.index(n)
+    except TypeError:
+        raise TypeError(f"{name} must be an integer, not {type(n).__name__}") from None
+    if not 0 <= n < 1 << 64:
+        raise ValueError(f"{name} must be in [0, 2**64), not {n}")
+    return n
+
+
+def _seed(seed):
+    if seed is None:
+        return None
+    return _count(seed, "seed")
+
+
+def _threads(threads):
+    if threads is None:
+        return None
+    threads = _count(threads, "threads")
+    if threads == 0:
+        raise ValueError("threads must be >= 1")
+    return threads
+
+
+def _spec(value, count, name):
+    """A 'a,b,c' string, or a sequence of `count` numbers written as one."""
+    if value is None or isinstance(value, str):
+        return value
+    numbers = [float(v) for v in value]
+    if len(numbers) != count:
+        raise ValueError(f"{name} takes {count} numbers, not {len(numbers)}")
+    # repr round-trips: the library parses the same doubles back
+    return ",".join(repr(v) for v in numbers)
+
+
+def _densities(density):
+    if isinstance(density, str):
+        return [density]
+    specs = list(density)
+    if not all(isinstance(s, str) for s in specs):
+        raise TypeError("density is a region string or a list of them")
+    return specs
+
+
+def _map(map, name="map"):
+    """(path, array) of a map given as a path or an array."""
+    if map is None:
+        return None, None
+    if isinstance(map, (str, bytes, os.PathLike)):
+        return os.fsdecode(map), None
+    array = np.ascontiguousarray(map, dtype=np.float64)
+    if array.ndim not in (2, 3) or (array.ndim == 3 and array.shape[2] != 3):
+        raise ValueError(f"a {name} array is H x W or H x W x 3; this one has shape {array.shape}")
+    return None, array
+
+
+def _warn(messages):
+    for message in messages:
+        _warnings.warn(message, RuntimeWarning, stacklevel=3)
+
+
+def _sphere_density(density, map, up, channel, strict):
+    if map is None:
+        if channel is not None or strict or up != "z":
+            raise ValueError("up, channel and strict apply to a map (map=...)")
+    elif density != "uniform":
+        raise ValueError("a map replaces the density: pass map= or density=, not both")
+    map_path, map_array = _map(map)
+    return _densities(density), map_path, map_array
+
+
+def sphere(
+    n,
+    density="uniform",
+    *,
+    map=None,
+    up="z",
+    channel=None,
+    strict=False,
+    within=None,
+    seed=None,
+    threads=None,
+    expected=False,
+    unsorted=False,
+    pdf=False,
+    relax=0,
+):
+    """Samples of the unit sphere: an (n, 3) float64 array of unit vectors.
+
+    What ``tessera sphere -n N`` writes, with the options of the same name.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples (exact unless ``expected``).
+    density : str or list of str
+        ``"uniform"``, ``"cap:LON,LAT,RADIUS_DEG,CONTRAST"`` (degrees; the
+        density is CONTRAST inside the cap, 1 outside) or
+        ``"polygon:LON LAT,LON LAT,...;CONTRAST"`` (a GeoJSON-style lon/lat
+        polygon). A list combines regions: the largest contrast of the
+        regions containing a point wins, 1 elsewhere.
+    map : path or array, optional
+        Importance from a lat-long map instead of ``density``: a file
+        (OpenEXR, Radiance .hdr or PNG), or an H x W array (importance) or
+        H x W x 3 array (linear RGB, taken in float32 as a file's channels
+        are, reduced to Rec.709 luminance as the library reduces a file's).
+        Row 0 is at +Z (theta = 0); column i covers phi = atan2(y, x) in
+        [2 pi i / W, 2 pi (i + 1) / W). Constant per pixel per unit solid
+        angle.
+    up : {"z", "y"}
+        The map's up axis; with "y" a direction (x, y, z) is looked up as
+        (z, x, y).
+    channel : str, optional
+        Use this channel of the map file (e.g. "R", "Y") instead of luminance.
+    strict : bool
+        Refuse maps with NaN or infinite pixels, or negative ones beyond a
+        lossy codec's noise; otherwise they count as 0 (with a warning).
+    within : str or (lon, lat, radius_deg), optional
+        Return only the samples of the request inside this cap; only the
+        tiles reaching it are visited, so a small window on a huge request
+        costs what the window holds. The count is then the expected one.
+        Not with a map, a seed or relax.
+    seed : int, optional
+        Sample in a uniformly random frame (a rotation) drawn from this
+        seed: estimates averaged over seeds are unbiased. Without it the
+        set is deterministic.
+    threads : int, optional
+        Worker threads (default: all cores). The output does not depend on it.
+    expected : bool
+        Skip the exactness pass: return the natural count near n.
+    unsorted : bool
+        The same samples in tile order instead of progressive order (a
+        prefix is then not well spread).
+    pdf : bool
+        Also return the pdf per steradian of each sample.
+    relax : int
+        Density-weighted Lloyd iterations run on the set: more even
+        spacing, but prefixes are no longer progressive and the pdf is the
+        target density's.
+
+    HEALPix map densities (``healpix=``, ``nest=``) are not there yet.
+
+    Returns
+    -------
+    points : (n, 3) ndarray, or (points, pdf) with ``pdf=True``.
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> points = tessera.sphere(4096)
+    >>> bool(np.allclose(np.linalg.norm(points, axis=1), 1.0))
+    True
+    >>> points, p = tessera.sphere(2000, ["cap:0,90,20,10", "cap:0,-90,20,10"], pdf=True)
+    >>> int((np.abs(points[:, 2]) > np.cos(np.radians(20))).sum()) > 700  # 39 % expected
+    True
+    >>> sky = np.ones((32, 64)); sky[2, 10] = 1000.0
+    >>> tessera.sphere(100, map=sky, seed=1).shape
+    (100, 3)
+    """
+    n = _count(n)
+    specs, map_path, map_array = _sphere_density(density, map, up, channel, strict)
+    points, pdfs, notes = _tessera.sphere(
+        n,
+        specs,
+        map_path,
+        map_array,
+        up,
+        channel,
+        bool(strict),
+        _spec(within, 3, "within"),
+        _seed(seed),
+        _threads(threads),
+        bool(expected),
+        bool(unsorted),
+        bool(pdf),
+        _count(relax, "relax"),
+    )
+    _warn(notes)
+    return (points, pdfs) if pdf else points
+
+
+def pdf(directions, density="uniform", *, map=None, up="z", channel=None, strict=False, threads=None, **request):
+    """The pdf per steradian that ``sphere`` samples follow, at any directions.
+
+    For multiple importance sampling: the same density options as
+    ``sphere`` (``density``, ``map``, ``up``, ``channel``, ``strict``).
+    ``sphere``'s other options (``within``, ``seed``, ``expected``,
+    ``unsorted``, ``relax``, ``n``) are accepted and do not change the pdf,
+    as in ``tessera sphere --format csv``. Directions (an (n, 3) or (3,)
+    array) need not be normalised.
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> float(tessera.pdf([0, 0, 1]) * 4 * np.pi)
+    1.0
+    >>> points, p = tessera.sphere(500, "cap:10,20,30,8", pdf=True)
+    >>> bool((tessera.pdf(points, "cap:10,20,30,8") == p).all())
+    True
+    """
+    unknown = set(request) - {"n", "within", "seed", "expected", "unsorted", "relax", "pdf"}
+    if unknown:
+        raise TypeError(f"pdf() got unexpected keyword argument(s): {', '.join(sorted(unknown))}")
+    directions = np.ascontiguousarray(directions, dtype=np.float64)
+    single = directions.ndim == 1
+    rows = directions.reshape(1, -1) if single else directions
+    if rows.ndim != 2 or rows.shape[1] != 3:
+        raise ValueError(f"directions are an (n, 3) array; this one has shape {directions.shape}")
+    specs, map_path, map_array = _sphere_density(density, map, up, channel, strict)
+    values, notes = _tessera.pdf(rows, specs, map_path, map_array, up, channel, bool(strict), _threads(threads))
+    _warn(notes)
+    return values[0] if single else values
+
+
+def plane(
+    n,
+    system="ghexomino",
+    density="uniform",
+    *,
+    image=None,
+    invert=False,
+    domain=None,
+    seed=None,
+    threads=None,
+    expected=False,
+    unsorted=False,
+    pdf=False,
+):
+    """Samples of the unit square (or a rectangle): an (n, 2) float64 array.
+
+    What ``tessera plane --system SYSTEM -n N`` writes, with the options of
+    the same name.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples (exact unless ``expected``).
+    system : {"ghexomino", "ppentomino", "penrose"}
+        The tile system.
+    density : str
+        ``"uniform"``, ``"ramp"`` (proportional to x) or ``"image:PATH"``.
+    image : path or array, optional
+        Importance from an image instead of ``density``: a file (OpenEXR,
+        Radiance .hdr or PNG; luminance as stored) or an H x W array (or
+        H x W x 3, reduced to luminance). x runs along the columns, y down
+        the rows from row 0.
+    invert : bool
+        Sample the image's complement ``max - value`` (stippling).
+    domain : str or (x0, y0, x1, y1), optional
+        Sample this rectangle instead of the unit square (the density's
+        unit square stretched over it).
+    seed : int, optional
+        Sample under a uniformly random toroidal shift drawn from this seed.
+    threads, expected, unsorted : as for ``sphere``.
+    pdf : bool
+        Also return the pdf per unit area of the domain of each sample.
+
+    Examples
+    --------
+    >>> import tessera
+    >>> tessera.plane(1000).shape
+    (1000, 2)
+    >>> points = tessera.plane(500, "penrose", "ramp", domain=(0, 0, 2, 1))
+    >>> bool((points[:, 0] < 2).all() and (points[:, 1] < 1).all())
+    True
+    """
+    n = _count(n)
+    if image is not None and density != "uniform":
+        raise ValueError("an image replaces the density: pass image= or density=, not both")
+    image_path, image_array = _map(image, "image")
+    points, pdfs, notes = _tessera.plane(
+        n,
+        str(system),
+        str(density),
+        image_path,
+        image_array,
+        bool(invert),
+        _spec(domain, 4, "domain"),
+        _seed(seed),
+        _threads(threads),
+        bool(expected),
+        bool(unsorted),
+        bool(pdf),
+    )
+    _warn(notes)
+    return (points, pdfs) if pdf else points
+
+
+def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=None, lloyd=3, threads=None):
+    """An environment map as n directional lights with exact powers.
+
+    What ``tessera lights --map MAP -n N`` writes, as a dict of arrays:
+    ``direction`` (n, 3) unit vectors towards the lights, ``rgb`` (n, 3)
+    the integral of each channel over the light's cell (map units x sr),
+    ``luminance`` (n,) the integral of the importance over the cell, and
+    ``solid_angle`` (n,) the cell's solid angle (sr). The cells partition
+    the sphere, so the powers sum to the map's integral.
+
+    Parameters
+    ----------
+    map : path or array
+        A lat-long map file (OpenEXR, Radiance .hdr, PNG) or an H x W x 3
+        (linear RGB, taken in float32) or H x W array, row 0 at +Z.
+    n : int
+        Number of lights (exactly).
+    up, channel, strict, seed, threads : as for ``sphere``.
+    exponent : float, optional
+        Directions follow value**exponent (default: a rule of n, 0.625 at
+        n <= 64, 0.875 at 256-1024, 0.95 from 4096).
+    lloyd : int
+        Lloyd steps after the first cut.
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> sky = np.ones((64, 128, 3)); sky[10, 40] = 500.0
+    >>> l = tessera.lights(sky, 16)
+    >>> sorted(l)
+    ['direction', 'luminance', 'rgb', 'solid_angle']
+    >>> bool(np.isclose(l["solid_angle"].sum(), 4 * np.pi))
+    True
+    """
+    map_path, map_array = _map(map)
+    if map_path is None and map_array is None:
+        raise ValueError("lights need a map (a path or an array)")
+    direction, rgb, luminance, solid_angle, notes = _tessera.lights(
+        map_path,
+        map_array,
+        _count(n),
+        up,
+        channel,
+        bool(strict),
+        _seed(seed),
+        None if exponent is None else float(exponent),
+        _count(lloyd, "lloyd"),
+        _threads(threads),
+    )
+    _warn(notes)
+    return {"direction": direction, "rgb": rgb, "luminance": luminance, "solid_angle": solid_angle}
+
+
+def lonlat(points):
+    """Longitude and latitude in degrees of vectors (..., 3): a (lon, lat) pair.
+
+    Longitude in [-180, 180) and latitude in [-90, 90], as ``tessera sphere
+    --format lonlat`` writes them (Z up, lon = atan2(y, x)). Vectors need
+    not be normalised.
+
+    Examples
+    --------
+    >>> import tessera
+    >>> lon, lat = tessera.lonlat([[-1.0, 0.0, 1.0]])
+    >>> float(lon[0]), round(float(lat[0]), 12)
+    (-180.0, 45.0)
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.shape[-1:] != (3,):
+        raise ValueError(f"points are a (..., 3) array; this one has shape {points.shape}")
+    lon, lat = _tessera.lonlat(points.reshape(-1, 3))
+    return lon.reshape(points.shape[:-1]), lat.reshape(points.shape[:-1])
+
+
+def from_lonlat(lon, lat):
+    """Unit vectors (..., 3) of longitudes and latitudes in degrees.
+
+    The inverse of ``lonlat`` (Z up); ``lon`` and ``lat`` broadcast.
+
+    Examples
+    --------
+    >>> import tessera
+    >>> tessera.from_lonlat(0.0, 90.0).round(12).tolist()
+    [0.0, 0.0, 1.0]
+    >>> tessera.from_lonlat([0, 90], 0).round(12).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    """
+    lon, lat = np.broadcast_arrays(np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64))
+    shape = lon.shape
+    points = _tessera.from_lonlat(np.ascontiguousarray(lon).reshape(-1), np.ascontiguousarray(lat).reshape(-1))
+    return points.reshape(shape + (3,))
+
+
+def stream(n, chunk=1 << 20):
+    """Uniform sphere samples in chunks of at most ``chunk`` rows, in bounded memory.
+
+    The n samples of ``sphere(n)``, in the same order (the library computes
+    uniform samples one at a time from their codes, with O(depth) state),
+    yielded as (k, 3) arrays: a billion points never need to be held at
+    once. Each chunk is computed without the GIL, on one thread.
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> chunks = list(tessera.stream(2500, chunk=1000))
+    >>> [len(c) for c in chunks]
+    [1000, 1000, 500]
+    >>> bool((np.concatenate(chunks) == tessera.sphere(2500)).all())
+    True
+    """
+    n = _count(n)
+    chunk = _count(chunk, "chunk")
+    return _tessera.Stream(n, chunk)
