@@ -247,10 +247,13 @@ impl SphereRequest {
     where
         D: Density<SphereRegion> + ?Sized,
     {
-        let mut points: Vec<DVec3> = samples.into_iter().map(|s| s.position).collect();
-        if self.relax > 0 {
-            crate::relax::relax(&mut points, density, self.relax)?;
+        // (`into_iter` and `collect` reuse the samples' memory, in one
+        // pass without relaxation)
+        if self.relax == 0 {
+            return Ok(samples.into_iter().map(|s| to_world(s.position)).collect());
         }
+        let mut points: Vec<DVec3> = samples.into_iter().map(|s| s.position).collect();
+        crate::relax::relax(&mut points, density, self.relax)?;
         Ok(points.into_iter().map(to_world).collect())
     }
 }
@@ -545,16 +548,17 @@ impl PlaneRequest {
             None => density,
         };
         let exact = !self.expected;
+        // (`into_iter` and `collect` reuse the samples' memory)
         let in_square: Vec<DVec2> = match self.seed {
             Some(seed) => {
                 let shifted = Shifted::new(square, seed);
                 engine::generate_ordered(tiling, &shifted, self.count, exact, self.order)?
-                    .iter()
+                    .into_iter()
                     .map(|s| shifted.to_world(s.position))
                     .collect()
             }
             None => engine::generate_ordered(tiling, square, self.count, exact, self.order)?
-                .iter()
+                .into_iter()
                 .map(|s| s.position)
                 .collect(),
         };

@@ -224,18 +224,22 @@ impl MapArray {
 enum MapSource {
     Path(PathBuf),
     Array(MapArray),
+    /// A map read once (`tessera.Map`), reused.
+    Ready(EnvMap),
 }
 
 fn map_source(
     path: Option<PathBuf>,
     array: Option<PyReadonlyArrayDyn<'_, f64>>,
+    ready: Option<PyRef<'_, Map>>,
 ) -> PyResult<Option<MapSource>> {
-    match (path, array) {
-        (Some(path), None) => Ok(Some(MapSource::Path(path))),
-        (None, Some(array)) => Ok(Some(MapSource::Array(MapArray::copy(&array)?))),
-        (None, None) => Ok(None),
-        (Some(_), Some(_)) => Err(PyValueError::new_err(
-            "a map is a path or an array, not both",
+    match (path, array, ready) {
+        (Some(path), None, None) => Ok(Some(MapSource::Path(path))),
+        (None, Some(array), None) => Ok(Some(MapSource::Array(MapArray::copy(&array)?))),
+        (None, None, Some(map)) => Ok(Some(MapSource::Ready(map.map.clone()))),
+        (None, None, None) => Ok(None),
+        _ => Err(PyValueError::new_err(
+            "a map is a path, an array or a tessera.Map, one of them",
         )),
     }
 }
@@ -250,6 +254,7 @@ fn sphere_density(
 ) -> Result<(SphereDensity, Vec<String>), Error> {
     match map {
         None => Ok((SphereDensity::parse(density)?, Vec::new())),
+        Some(MapSource::Ready(map)) => Ok((SphereDensity::Map(map.clone()), Vec::new())),
         Some(MapSource::Path(path)) => {
             let options = ReadOptions {
                 channel,
@@ -280,24 +285,17 @@ fn sphere_density(
     }
 }
 
-/// `Vec<DVec3>` as an (n, 3) array, reusing its memory.
+/// `Vec<DVec3>` as an (n, 3) array, in its memory (no copy).
 fn points3(py: Python<'_>, points: Vec<DVec3>) -> PyResult<Bound<'_, PyArray2<f64>>> {
     let n = points.len();
-    let flat: Vec<f64> = points
-        .into_iter()
-        .map(|p| p.to_array())
-        .collect::<Vec<[f64; 3]>>()
-        .into_flattened();
+    let flat: Vec<f64> = bytemuck::allocation::cast_vec(points);
     PyArray1::from_vec(py, flat).reshape([n, 3])
 }
 
+/// `Vec<DVec2>` as an (n, 2) array, in its memory (no copy).
 fn points2(py: Python<'_>, points: Vec<DVec2>) -> PyResult<Bound<'_, PyArray2<f64>>> {
     let n = points.len();
-    let flat: Vec<f64> = points
-        .into_iter()
-        .map(|p| p.to_array())
-        .collect::<Vec<[f64; 2]>>()
-        .into_flattened();
+    let flat: Vec<f64> = bytemuck::allocation::cast_vec(points);
     PyArray1::from_vec(py, flat).reshape([n, 2])
 }
 
@@ -329,7 +327,7 @@ type Columns<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// See `tessera.sphere`.
 #[pyfunction]
-#[pyo3(signature = (n, density, map_path, map_array, up, channel, strict, within, seed, threads, expected, unsorted, pdf, relax))]
+#[pyo3(signature = (n, density, map_path, map_array, map_ready, up, channel, strict, within, seed, threads, expected, unsorted, pdf, relax))]
 #[allow(clippy::too_many_arguments)]
 fn sphere<'py>(
     py: Python<'py>,
@@ -337,6 +335,7 @@ fn sphere<'py>(
     density: Vec<String>,
     map_path: Option<PathBuf>,
     map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
+    map_ready: Option<PyRef<'py, Map>>,
     up: &str,
     channel: Option<String>,
     strict: bool,
@@ -349,7 +348,7 @@ fn sphere<'py>(
     relax: usize,
 ) -> PyResult<PointsOut<'py>> {
     let up = up_axis(up)?;
-    let map = map_source(map_path, map_array)?;
+    let map = map_source(map_path, map_array, map_ready)?;
     let (points, pdfs, warnings) = run(py, threads, move || {
         let (density, warnings) = sphere_density(&density, map.as_ref(), up, channel, strict)?;
         let request = SphereRequest {
@@ -373,7 +372,7 @@ fn sphere<'py>(
 
 /// See `tessera.pdf`.
 #[pyfunction]
-#[pyo3(signature = (directions, density, map_path, map_array, up, channel, strict, threads))]
+#[pyo3(signature = (directions, density, map_path, map_array, map_ready, up, channel, strict, threads))]
 #[allow(clippy::too_many_arguments)]
 fn pdf<'py>(
     py: Python<'py>,
@@ -381,13 +380,14 @@ fn pdf<'py>(
     density: Vec<String>,
     map_path: Option<PathBuf>,
     map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
+    map_ready: Option<PyRef<'py, Map>>,
     up: &str,
     channel: Option<String>,
     strict: bool,
     threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Warnings)> {
     let up = up_axis(up)?;
-    let map = map_source(map_path, map_array)?;
+    let map = map_source(map_path, map_array, map_ready)?;
     let directions: Vec<DVec3> = rows::<3>(&directions)?
         .into_iter()
         .map(DVec3::from_array)
@@ -505,7 +505,7 @@ fn lights<'py>(
     threads: Option<usize>,
 ) -> PyResult<LightsOut<'py>> {
     let up = up_axis(up)?;
-    let map = map_source(map_path, map_array)?
+    let map = map_source(map_path, map_array, None)?
         .ok_or_else(|| PyValueError::new_err("lights need a map (a path or an array)"))?;
     let (lights, warnings) = run(py, threads, move || {
         let (map, rgb, warnings): (EnvMap, RgbMap, Warnings) = match &map {
@@ -538,6 +538,7 @@ fn lights<'py>(
                 warnings.extend(more);
                 (map, rgb, warnings)
             }
+            MapSource::Ready(_) => unreachable!("lights read their map themselves"),
         };
         let options = tessera::lights::LightOptions {
             rgb: Some(&rgb),
@@ -647,6 +648,57 @@ fn metrics_plane<'py>(
     Ok(pythonize::pythonize(py, &report)?)
 }
 
+/// A lat-long map read once, to sample and to give pdfs again and again
+/// (`tessera.Map`): its max pyramid, built as sampling needs it, is kept.
+#[pyclass(module = "tessera._tessera", frozen)]
+struct Map {
+    map: EnvMap,
+}
+
+#[pymethods]
+impl Map {
+    /// Width in pixels.
+    #[getter]
+    fn width(&self) -> usize {
+        self.map.width()
+    }
+
+    /// Height in pixels.
+    #[getter]
+    fn height(&self) -> usize {
+        self.map.height()
+    }
+
+    /// The map's integral over the sphere (value x sr): the pdf's normaliser.
+    #[getter]
+    fn integral(&self) -> f64 {
+        self.map.integral()
+    }
+}
+
+/// See `tessera.Map`.
+#[pyfunction]
+#[pyo3(signature = (map_path, map_array, up, channel, strict))]
+fn open_map<'py>(
+    py: Python<'py>,
+    map_path: Option<PathBuf>,
+    map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
+    up: &str,
+    channel: Option<String>,
+    strict: bool,
+) -> PyResult<(Map, Warnings)> {
+    let up = up_axis(up)?;
+    let source = map_source(map_path, map_array, None)?
+        .ok_or_else(|| PyValueError::new_err("a map is a path or an array"))?;
+    run(py, None, move || {
+        let (density, warnings) = sphere_density(&[], Some(&source), up, channel, strict)?;
+        match density {
+            SphereDensity::Map(map) => Ok((Map { map }, warnings)),
+            SphereDensity::Regions(_) => unreachable!("a map source gives a map"),
+        }
+    })
+}
+
 /// The sphere tiling the streams walk (it lives as long as the module).
 fn tiling() -> &'static SphereTiling {
     static TILING: OnceLock<SphereTiling> = OnceLock::new();
@@ -706,7 +758,9 @@ fn _tessera(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_lonlat, m)?)?;
     m.add_function(wrap_pyfunction!(metrics_sphere, m)?)?;
     m.add_function(wrap_pyfunction!(metrics_plane, m)?)?;
+    m.add_function(wrap_pyfunction!(open_map, m)?)?;
     m.add_class::<Stream>()?;
+    m.add_class::<Map>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

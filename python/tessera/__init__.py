@@ -30,6 +30,7 @@ from . import _tessera
 from . import metrics
 
 __all__ = [
+    "Map",
     "sphere",
     "pdf",
     "plane",
@@ -89,15 +90,17 @@ def _densities(density):
 
 
 def _map(map, name="map"):
-    """(path, array) of a map given as a path or an array."""
+    """(path, array, prepared map) of a map given as a path, an array or a Map."""
     if map is None:
-        return None, None
+        return None, None, None
+    if isinstance(map, Map):
+        return None, None, map._native
     if isinstance(map, (str, bytes, os.PathLike)):
-        return os.fsdecode(map), None
+        return os.fsdecode(map), None, None
     array = np.ascontiguousarray(map, dtype=np.float64)
     if array.ndim not in (2, 3) or (array.ndim == 3 and array.shape[2] != 3):
         raise ValueError(f"a {name} array is H x W or H x W x 3; this one has shape {array.shape}")
-    return None, array
+    return None, array, None
 
 
 def _warn(messages):
@@ -111,8 +114,57 @@ def _sphere_density(density, map, up, channel, strict):
             raise ValueError("up, channel and strict apply to a map (map=...)")
     elif density != "uniform":
         raise ValueError("a map replaces the density: pass map= or density=, not both")
-    map_path, map_array = _map(map)
-    return _densities(density), map_path, map_array
+    elif isinstance(map, Map) and (channel is not None or strict or up != "z"):
+        raise ValueError("a tessera.Map was read with its up, channel and strict: give them to Map()")
+    map_path, map_array, map_ready = _map(map)
+    return _densities(density), map_path, map_array, map_ready
+
+
+class Map:
+    """A lat-long map read once, for many ``sphere`` and ``pdf`` calls.
+
+    ``sphere(n, map=path_or_array)`` reads the file (or copies the array)
+    and builds the map on every call; a renderer asking for samples and
+    pdfs again and again passes a ``Map`` instead: it is read once, and the
+    bounds sampling builds over it are kept. The arguments are those of
+    ``sphere``'s ``map``, ``up``, ``channel`` and ``strict``; warnings about
+    the map are given here.
+
+    Attributes: ``width``, ``height`` and ``integral`` (of the map over the
+    sphere, value x sr: the pdf's normaliser).
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> sky = tessera.Map(np.ones((32, 64)))
+    >>> sky.width, sky.height, round(sky.integral / np.pi, 12)
+    (64, 32, 4.0)
+    >>> points, p = tessera.sphere(100, map=sky, pdf=True)
+    >>> bool((tessera.pdf(points, map=sky) == p).all())
+    True
+    """
+
+    def __init__(self, map, *, up="z", channel=None, strict=False):
+        if isinstance(map, Map):
+            raise TypeError("map is already a tessera.Map")
+        path, array, _ = _map(map)
+        self._native, notes = _tessera.open_map(path, array, up, channel, bool(strict))
+        _warn(notes)
+
+    @property
+    def width(self):
+        return self._native.width
+
+    @property
+    def height(self):
+        return self._native.height
+
+    @property
+    def integral(self):
+        return self._native.integral
+
+    def __repr__(self):
+        return f"tessera.Map({self.width}x{self.height}, integral {self.integral:g})"
 
 
 def sphere(
@@ -145,9 +197,10 @@ def sphere(
         ``"polygon:LON LAT,LON LAT,...;CONTRAST"`` (a GeoJSON-style lon/lat
         polygon). A list combines regions: the largest contrast of the
         regions containing a point wins, 1 elsewhere.
-    map : path or array, optional
+    map : path, array or Map, optional
         Importance from a lat-long map instead of ``density``: a file
-        (OpenEXR, Radiance .hdr or PNG), or an H x W array (importance) or
+        (OpenEXR, Radiance .hdr or PNG), a ``tessera.Map`` read once for
+        many calls, or an H x W array (importance) or
         H x W x 3 array (linear RGB, taken in float32 as a file's channels
         are, reduced to Rec.709 luminance as the library reduces a file's).
         Row 0 is at +Z (theta = 0); column i covers phi = atan2(y, x) in
@@ -204,12 +257,13 @@ def sphere(
     (100, 3)
     """
     n = _count(n)
-    specs, map_path, map_array = _sphere_density(density, map, up, channel, strict)
+    specs, map_path, map_array, map_ready = _sphere_density(density, map, up, channel, strict)
     points, pdfs, notes = _tessera.sphere(
         n,
         specs,
         map_path,
         map_array,
+        map_ready,
         up,
         channel,
         bool(strict),
@@ -229,7 +283,8 @@ def pdf(directions, density="uniform", *, map=None, up="z", channel=None, strict
     """The pdf per steradian that ``sphere`` samples follow, at any directions.
 
     For multiple importance sampling: the same density options as
-    ``sphere`` (``density``, ``map``, ``up``, ``channel``, ``strict``).
+    ``sphere`` (``density``, ``map``, ``up``, ``channel``, ``strict``); in a
+    render loop pass a ``tessera.Map``, read once.
     ``sphere``'s other options (``within``, ``seed``, ``expected``,
     ``unsorted``, ``relax``, ``n``) are accepted and do not change the pdf,
     as in ``tessera sphere --format csv``. Directions (an (n, 3) or (3,)
@@ -252,8 +307,10 @@ def pdf(directions, density="uniform", *, map=None, up="z", channel=None, strict
     rows = directions.reshape(1, -1) if single else directions
     if rows.ndim != 2 or rows.shape[1] != 3:
         raise ValueError(f"directions are an (n, 3) array; this one has shape {directions.shape}")
-    specs, map_path, map_array = _sphere_density(density, map, up, channel, strict)
-    values, notes = _tessera.pdf(rows, specs, map_path, map_array, up, channel, bool(strict), _threads(threads))
+    specs, map_path, map_array, map_ready = _sphere_density(density, map, up, channel, strict)
+    values, notes = _tessera.pdf(
+        rows, specs, map_path, map_array, map_ready, up, channel, bool(strict), _threads(threads)
+    )
     _warn(notes)
     return values[0] if single else values
 
@@ -313,7 +370,9 @@ def plane(
     n = _count(n)
     if image is not None and density != "uniform":
         raise ValueError("an image replaces the density: pass image= or density=, not both")
-    image_path, image_array = _map(image, "image")
+    if isinstance(image, Map):
+        raise TypeError("an image is a path or an array, not a tessera.Map")
+    image_path, image_array, _ = _map(image, "image")
     points, pdfs, notes = _tessera.plane(
         n,
         str(system),
@@ -366,7 +425,9 @@ def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=No
     >>> bool(np.isclose(l["solid_angle"].sum(), 4 * np.pi))
     True
     """
-    map_path, map_array = _map(map)
+    if isinstance(map, Map):
+        raise TypeError("lights read their map's colour: pass the path or the array, not a tessera.Map")
+    map_path, map_array, _ = _map(map)
     if map_path is None and map_array is None:
         raise ValueError("lights need a map (a path or an array)")
     direction, rgb, luminance, solid_angle, notes = _tessera.lights(

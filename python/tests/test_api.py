@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import tessera
-from conftest import sky, write_exr
+from maps import sky, write_exr
 
 
 def test_docstring_examples_run():
@@ -156,6 +156,8 @@ def test_bad_requests_raise_value_error_with_the_library_message(tmp_path):
         (lambda: tessera.metrics.sphere(np.ones((5, 3))), "not a unit vector"),
         (lambda: tessera.metrics.plane(np.zeros((0, 2))), "no points"),
         (lambda: tessera.stream(10, chunk=0), "chunk must be at least 1"),
+        (lambda: tessera.sphere(10, map=tessera.Map(np.ones((4, 8))), up="y"), "give them to Map()"),
+        (lambda: tessera.Map(np.zeros((4, 8))), "nothing to sample"),
         (lambda: tessera.stream(10**30), "must be in"),
     ]
     for call, message in cases:
@@ -188,6 +190,19 @@ def test_files_raise_os_errors_naming_the_file(tmp_path):
     write_exr(path, {"R": rgb[..., 0], "G": rgb[..., 1], "B": rgb[..., 2]})
     with pytest.raises(ValueError, match="no channel named 'Q'"):
         tessera.sphere(10, map=path, channel="Q")
+
+
+def test_maps_read_once_are_reused():
+    rgb = sky()
+    prepared = tessera.Map(rgb, up="y")
+    assert (prepared.width, prepared.height) == (64, 32)
+    assert prepared.integral > 0
+    for seed in (None, 3):
+        assert (tessera.sphere(700, map=prepared, seed=seed) == tessera.sphere(700, map=rgb, up="y", seed=seed)).all()
+    with pytest.raises(TypeError, match="colour"):
+        tessera.lights(prepared, 4)
+    with pytest.warns(RuntimeWarning, match="not a 2:1"):
+        tessera.Map(np.ones((10, 10)))
 
 
 def test_bad_pixels_warn_or_are_refused_with_strict():

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import tessera
-from conftest import read_csv, read_utk, write_exr, write_png
+from conftest import read_csv, read_utk
+from maps import write_exr, write_png
 
 
 def same(a, b):
@@ -84,6 +85,10 @@ def test_map_file_and_array_are_the_cli_map(cli, sky_exr):
     # the same values as an array (float32, as the file holds them), or in float64
     same(tessera.sphere(4000, map=rgb), expected)
     same(tessera.sphere(4000, map=rgb.astype(np.float64)), expected)
+    # or read once, for many calls
+    prepared = tessera.Map(path)
+    same(tessera.sphere(4000, map=prepared), expected)
+    same(tessera.sphere(4000, map=tessera.Map(rgb)), expected)
     # with a seed, the other axis, a channel, the pdf column
     for options, args in [
         (dict(seed=11), ["--seed", "11"]),
@@ -95,6 +100,11 @@ def test_map_file_and_array_are_the_cli_map(cli, sky_exr):
         points, pdf = tessera.sphere(3000, map=path, pdf=True, **options)
         same(points, rows[:, :3])
         same(pdf, rows[:, 5])
+        read_as = {k: v for k, v in options.items() if k in ("up", "channel")}
+        request = {k: v for k, v in options.items() if k not in read_as}
+        prepared = tessera.Map(path, **read_as)
+        same(tessera.sphere(3000, map=prepared, **request), points)
+        same(tessera.pdf(points, map=prepared), pdf)
         if "channel" not in options:
             same(tessera.sphere(3000, map=rgb, **options), points)
     # a grey array is the file's Y channel
