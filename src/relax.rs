@@ -3,14 +3,14 @@
 //! even spacing and accept losing the progressive order and the exact pdf.
 //!
 //! One iteration moves every point to the centroid of its spherical
-//! Voronoi cell ([`crate::voronoi`]), weighted by `density²`: in two
+//! Voronoi cell (exact, in gnomonic charts), weighted by `density²`: in two
 //! dimensions a CVT of weight `w` has point density about `w^(1/2)`
 //! (Gersho's asymptotics), so the square keeps the point density
 //! proportional to the density itself. Each cell is integrated in the
 //! gnomonic chart of its site (area element `(1 + |u|²)^(-3/2) du`) by a
 //! degree-5, 7-point rule on a fan of triangles from the site, split in
 //! four when the density varies. Points move 1.8 times the way to their
-//! centroid (over-relaxation: faster, see [`OVER_RELAXATION`]). Cost O(N log N) an iteration (a k-d tree
+//! centroid (over-relaxation: faster, see `OVER_RELAXATION` in the source). Cost O(N log N) an iteration (a k-d tree
 //! and k nearest neighbours a point), parallel with rayon.
 //!
 //! What it changes: prefixes of the relaxed set are no longer well spread
