@@ -258,19 +258,91 @@ impl SphereRequest {
     }
 }
 
-/// A lat-long map read from `path` as `tessera sphere --map` reads it, with
-/// the warnings it prints (see [`map_from_raster`]). Errors name the file.
+/// Something worth telling about a map that was read all the same.
 ///
 /// # Example
 /// ```
-/// use tessera::{density::envmap::Up, request::open_map};
+/// use tessera::request::MapWarning;
+/// let w = MapWarning::NotTwoToOne { name: "sky.exr".into(), width: 3, height: 1 };
+/// assert_eq!(w.message("--strict"), "sky.exr: 3x1 is not a 2:1 lat-long map; using it as one");
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MapWarning {
+    /// Pixels (and, for lights, colour samples) that were negative, NaN or
+    /// infinite and were set to 0.
+    BadPixels {
+        /// The file, or what data in memory is called.
+        name: std::path::PathBuf,
+        /// Importance pixels set to 0.
+        pixels: usize,
+        /// Colour samples set to 0, when the colour was read too.
+        colour_samples: Option<usize>,
+    },
+    /// A map that is not 2:1, used as a lat-long map all the same.
+    NotTwoToOne {
+        /// The file, or what data in memory is called.
+        name: std::path::PathBuf,
+        /// Columns.
+        width: usize,
+        /// Rows.
+        height: usize,
+    },
+}
+
+impl MapWarning {
+    /// The warning as `tessera` prints it, naming the strict option as the
+    /// caller spells it (`--strict` on the command line).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::request::MapWarning;
+    /// let w = MapWarning::BadPixels { name: "a.exr".into(), pixels: 2, colour_samples: Some(5) };
+    /// assert!(w.message("strict=True").ends_with("treated as 0 (strict=True refuses them)"));
+    /// ```
+    pub fn message(&self, strict: &str) -> String {
+        match self {
+            MapWarning::BadPixels {
+                name,
+                pixels,
+                colour_samples: None,
+            } => format!(
+                "{}: {pixels} negative, NaN or infinite pixel(s) treated as 0 ({strict} refuses NaN, infinities and negatives beyond codec noise)",
+                name.display()
+            ),
+            MapWarning::BadPixels {
+                name,
+                pixels,
+                colour_samples: Some(colour),
+            } => format!(
+                "{}: {pixels} pixel(s) and {colour} colour sample(s) negative, NaN or infinite, treated as 0 ({strict} refuses them)",
+                name.display()
+            ),
+            MapWarning::NotTwoToOne {
+                name,
+                width,
+                height,
+            } => format!(
+                "{}: {width}x{height} is not a 2:1 lat-long map; using it as one",
+                name.display()
+            ),
+        }
+    }
+}
+
+/// A lat-long map read from `path` as `tessera sphere --map` reads it, with
+/// the warnings it prints (bad pixels set to 0, then
+/// [`map_from_raster`]'s). Errors name the file.
+///
+/// # Example
+/// ```
+/// use tessera::{density::envmap::Up, request::{open_map, MapWarning}};
 /// let dir = std::env::temp_dir().join(format!("tessera-doc-open-map-{}", std::process::id()));
 /// std::fs::create_dir_all(&dir).unwrap();
 /// let path = dir.join("wide.exr");
 /// exr::prelude::write_rgb_file(&path, 3, 1, |x, _| (x as f32, 1.0f32, 0.0f32)).unwrap();
 /// let (map, warnings) = open_map(&path, &Default::default(), Up::Z).unwrap();
 /// assert_eq!((map.width(), map.height()), (3, 1));
-/// assert!(warnings[0].contains("not a 2:1"));
+/// assert!(matches!(warnings[..], [MapWarning::NotTwoToOne { width: 3, height: 1, .. }]));
 /// assert!(open_map(&dir.join("missing.exr"), &Default::default(), Up::Z).is_err());
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
@@ -278,15 +350,15 @@ pub fn open_map(
     path: &Path,
     options: &ReadOptions,
     up: Up,
-) -> Result<(EnvMap, Vec<String>), Error> {
+) -> Result<(EnvMap, Vec<MapWarning>), Error> {
     let raster = read_raster(path, options)?;
     let mut warnings = Vec::new();
     if raster.bad_pixels > 0 {
-        warnings.push(format!(
-            "{}: {} negative, NaN or infinite pixel(s) treated as 0 (a strict read refuses NaN, infinities and negatives beyond codec noise)",
-            path.display(),
-            raster.bad_pixels
-        ));
+        warnings.push(MapWarning::BadPixels {
+            name: path.into(),
+            pixels: raster.bad_pixels,
+            colour_samples: None,
+        });
     }
     let (map, more) = map_from_raster(path, raster, up)?;
     warnings.extend(more);
@@ -302,33 +374,29 @@ pub fn open_map(
 /// ```
 /// use tessera::{density::envmap::Up, io::image::Raster, request::map_from_raster};
 /// let raster = Raster::from_values("mem", 4, 2, vec![1.0; 8], false).unwrap();
-/// let (map, warnings) = map_from_raster("mem".as_ref(), raster, Up::Y).unwrap();
-/// assert!(warnings.is_empty() && map.up() == Up::Y);
+/// let (map, warning) = map_from_raster("mem".as_ref(), raster, Up::Y).unwrap();
+/// assert!(warning.is_none() && map.up() == Up::Y);
 /// ```
 pub fn map_from_raster(
     name: &Path,
     raster: Raster,
     up: Up,
-) -> Result<(EnvMap, Vec<String>), Error> {
-    let mut warnings = Vec::new();
-    if raster.width != 2 * raster.height {
-        warnings.push(format!(
-            "{}: {}x{} is not a 2:1 lat-long map; using it as one",
-            name.display(),
-            raster.width,
-            raster.height
-        ));
-    }
+) -> Result<(EnvMap, Option<MapWarning>), Error> {
+    let warning = (raster.width != 2 * raster.height).then(|| MapWarning::NotTwoToOne {
+        name: name.into(),
+        width: raster.width,
+        height: raster.height,
+    });
     let map = EnvMap::new(raster, up).map_err(|e| Error::File {
         path: name.into(),
         reason: e.to_string(),
     })?;
-    Ok((map, warnings))
+    Ok((map, warning))
 }
 
 /// A map file's importance and colour as `tessera lights` reads them
 /// ([`crate::lights::read_rgb`]), its environment map and the warnings it
-/// prints (bad samples zeroed, a map that is not 2:1).
+/// prints (bad samples set to 0, a map that is not 2:1).
 ///
 /// # Example
 /// ```
@@ -345,16 +413,15 @@ pub fn open_light_map(
     path: &Path,
     options: &ReadOptions,
     up: Up,
-) -> Result<(EnvMap, RgbMap, Vec<String>), Error> {
+) -> Result<(EnvMap, RgbMap, Vec<MapWarning>), Error> {
     let (rgb, raster) = crate::lights::read_rgb(path, options)?;
     let mut warnings = Vec::new();
     if raster.bad_pixels > 0 || rgb.bad_samples > 0 {
-        warnings.push(format!(
-            "{}: {} pixel(s) and {} colour sample(s) negative, NaN or infinite, treated as 0 (a strict read refuses them)",
-            path.display(),
-            raster.bad_pixels,
-            rgb.bad_samples
-        ));
+        warnings.push(MapWarning::BadPixels {
+            name: path.into(),
+            pixels: raster.bad_pixels,
+            colour_samples: Some(rgb.bad_samples),
+        });
     }
     let (map, more) = map_from_raster(path, raster, up)?;
     warnings.extend(more);

@@ -21,7 +21,7 @@ use tessera::density::sphere::Cap;
 use tessera::engine::Order;
 use tessera::io::image::{Raster, ReadOptions};
 use tessera::lights::RgbMap;
-use tessera::request::{PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
+use tessera::request::{MapWarning, PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
 use tessera::tiling::sphere::SphereTiling;
 use tessera::Error;
 
@@ -244,6 +244,13 @@ fn map_source(
     }
 }
 
+/// How warnings name the strict option.
+const STRICT: &str = "strict=True";
+
+fn messages(warnings: impl IntoIterator<Item = MapWarning>) -> Warnings {
+    warnings.into_iter().map(|w| w.message(STRICT)).collect()
+}
+
 /// The density of a sphere request and the warnings its map deserves.
 fn sphere_density(
     density: &[String],
@@ -251,7 +258,7 @@ fn sphere_density(
     up: Up,
     channel: Option<String>,
     strict: bool,
-) -> Result<(SphereDensity, Vec<String>), Error> {
+) -> Result<(SphereDensity, Warnings), Error> {
     match map {
         None => Ok((SphereDensity::parse(density)?, Vec::new())),
         Some(MapSource::Ready(map)) => Ok((SphereDensity::Map(map.clone()), Vec::new())),
@@ -262,7 +269,7 @@ fn sphere_density(
                 ..Default::default()
             };
             let (map, warnings) = tessera::request::open_map(path, &options, up)?;
-            Ok((SphereDensity::Map(map), warnings))
+            Ok((SphereDensity::Map(map), messages(warnings)))
         }
         Some(MapSource::Array(array)) => {
             if channel.is_some() {
@@ -273,13 +280,15 @@ fn sphere_density(
             let raster = array.raster(strict)?;
             let mut warnings = Vec::new();
             if raster.bad_pixels > 0 {
-                warnings.push(format!(
-                    "{MAP_ARRAY}: {} negative, NaN or infinite pixel(s) treated as 0 (strict=True refuses them)",
-                    raster.bad_pixels
-                ));
+                warnings.push(MapWarning::BadPixels {
+                    name: MAP_ARRAY.into(),
+                    pixels: raster.bad_pixels,
+                    colour_samples: None,
+                });
             }
             let (map, more) = tessera::request::map_from_raster(MAP_ARRAY.as_ref(), raster, up)?;
             warnings.extend(more);
+            let warnings = messages(warnings);
             Ok((SphereDensity::Map(map), warnings))
         }
     }
@@ -515,7 +524,8 @@ fn lights<'py>(
                     strict,
                     ..Default::default()
                 };
-                tessera::request::open_light_map(path, &options, up)?
+                let (map, rgb, warnings) = tessera::request::open_light_map(path, &options, up)?;
+                (map, rgb, messages(warnings))
             }
             MapSource::Array(array) => {
                 if channel.is_some() {
@@ -528,15 +538,16 @@ fn lights<'py>(
                 let rgb = array.colour(strict)?;
                 let mut warnings = Vec::new();
                 if raster.bad_pixels > 0 || rgb.bad_samples > 0 {
-                    warnings.push(format!(
-                        "{MAP_ARRAY}: {} pixel(s) and {} colour sample(s) negative, NaN or infinite, treated as 0 (strict=True refuses them)",
-                        raster.bad_pixels, rgb.bad_samples
-                    ));
+                    warnings.push(MapWarning::BadPixels {
+                        name: MAP_ARRAY.into(),
+                        pixels: raster.bad_pixels,
+                        colour_samples: Some(rgb.bad_samples),
+                    });
                 }
                 let (map, more) =
                     tessera::request::map_from_raster(MAP_ARRAY.as_ref(), raster, up)?;
                 warnings.extend(more);
-                (map, rgb, warnings)
+                (map, rgb, messages(warnings))
             }
             MapSource::Ready(_) => unreachable!("lights read their map themselves"),
         };
@@ -596,10 +607,11 @@ fn from_lonlat<'py>(
 
 /// See `tessera.metrics.sphere`.
 #[pyfunction]
-#[pyo3(signature = (points, threads))]
+#[pyo3(signature = (points, pairs_up_to, threads))]
 fn metrics_sphere<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
+    pairs_up_to: usize,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let points: Vec<DVec3> = rows::<3>(&points)?
@@ -616,17 +628,21 @@ fn metrics_sphere<'py>(
         )));
     }
     let report = run(py, threads, move || {
-        Ok(tessera::metrics::sphere_report(&points))
+        Ok(tessera::metrics::sphere::sphere_report_up_to(
+            &points,
+            pairs_up_to,
+        ))
     })?;
     Ok(pythonize::pythonize(py, &report)?)
 }
 
 /// See `tessera.metrics.plane`.
 #[pyfunction]
-#[pyo3(signature = (points, threads))]
+#[pyo3(signature = (points, pairs_up_to, threads))]
 fn metrics_plane<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
+    pairs_up_to: usize,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let points: Vec<DVec2> = rows::<2>(&points)?
@@ -643,7 +659,10 @@ fn metrics_plane<'py>(
         )));
     }
     let report = run(py, threads, move || {
-        Ok(tessera::metrics::plane_report(&points))
+        Ok(tessera::metrics::plane::plane_report_up_to(
+            &points,
+            pairs_up_to,
+        ))
     })?;
     Ok(pythonize::pythonize(py, &report)?)
 }

@@ -200,3 +200,11 @@ def test_metrics_are_the_cli_metrics(cli, tmp_path):
     report = tessera.metrics.plane(tessera.plane(1200, "penrose", "ramp"))
     assert sorted(report) == sorted(expected)
     assert report == expected
+    # beyond --pairs-up-to the O(N^2) measures are null there, NaN here
+    for domain, path, measure in [("sphere", points_file, tessera.metrics.sphere), ("plane", plane_file, tessera.metrics.plane)]:
+        expected = json.loads(cli("metrics", domain, path, "--json", "--pairs-up-to", 1000))
+        dims = 3 if domain == "sphere" else 2
+        report = measure(read_utk(path.read_bytes()).reshape(-1, dims), pairs_up_to=1000)
+        skipped = [k for k, v in expected.items() if v is None]
+        assert skipped and all(np.isnan(report[k]) for k in skipped)
+        assert {k: v for k, v in report.items() if k not in skipped} == {k: v for k, v in expected.items() if k not in skipped}

@@ -56,7 +56,7 @@ pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
     let (map, rgb, warnings) =
         tessera::request::open_light_map(&args.map, &options, args.up.into())?;
     for warning in warnings {
-        eprintln!("tessera: warning: {warning}");
+        eprintln!("tessera: warning: {}", warning.message("--strict"));
     }
     let options = LightOptions {
         rgb: Some(&rgb),

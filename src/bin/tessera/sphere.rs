@@ -116,7 +116,7 @@ fn open_map(path: &Path, args: &SphereArgs) -> Result<tessera::density::envmap::
     };
     let (map, warnings) = tessera::request::open_map(path, &options, args.up.into())?;
     for warning in warnings {
-        eprintln!("tessera: warning: {warning}");
+        eprintln!("tessera: warning: {}", warning.message("--strict"));
     }
     Ok(map)
 }
