@@ -32,17 +32,6 @@ use crate::Error;
 use glam::{DVec2, DVec3};
 use std::path::Path;
 
-/// Uniform requests above this many samples stream one at a time (one
-/// thread, O(depth) memory) in [`SphereRequest::with_points`] and
-/// [`PlaneRequest::with_points`], instead of being generated in parallel
-/// in memory. The points are the same either way.
-///
-/// # Example
-/// ```
-/// assert_eq!(tessera::request::STREAM_ABOVE, 1 << 24);
-/// ```
-pub const STREAM_ABOVE: usize = 1 << 24;
-
 /// What a sphere request samples: the command line's region strings
 /// (`--density`) or a lat-long environment map (`--map`).
 ///
@@ -192,9 +181,9 @@ impl SphereRequest {
     }
 
     /// [`SphereRequest::points`] handed to `sink` as an exact-size
-    /// iterator: a uniform request of more than [`STREAM_ABOVE`] samples
-    /// (without window or relaxation) streams in O(depth) memory, others
-    /// are generated in memory first. This is how `tessera sphere` writes.
+    /// iterator: a uniform request (without window or relaxation) streams
+    /// block by block in bounded memory ([`engine::stream`]), others are
+    /// generated in memory first. This is how `tessera sphere` writes.
     ///
     /// # Example
     /// ```
@@ -213,7 +202,7 @@ impl SphereRequest {
             let tiling = SphereTiling::default();
             let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
             match engine::stream(&tiling, self.count) {
-                Some(stream) if uniform && self.count > STREAM_ABOVE => {
+                Some(stream) if uniform => {
                     // the frame of `Rotated::new(density, seed)`
                     let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
                     let mut points = stream.map(|s| match &frame {
@@ -534,9 +523,9 @@ impl PlaneRequest {
     }
 
     /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
-    /// a uniform request of more than [`STREAM_ABOVE`] samples on the unit
-    /// square without seed streams in O(depth) memory. This is how
-    /// `tessera plane` writes.
+    /// a uniform request on the unit square without seed streams block by
+    /// block in bounded memory ([`engine::stream`]). This is how `tessera
+    /// plane` writes.
     ///
     /// # Example
     /// ```
@@ -550,10 +539,7 @@ impl PlaneRequest {
         density: &dyn Density<PlaneRegion>,
         sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec2>) -> R,
     ) -> Result<R, Error> {
-        let streams = density.constant().is_some()
-            && self.domain.is_none()
-            && self.seed.is_none()
-            && self.count > STREAM_ABOVE;
+        let streams = density.constant().is_some() && self.domain.is_none() && self.seed.is_none();
         if streams {
             let penrose;
             let polyomino;

@@ -680,3 +680,39 @@ fn offsets_stay_near_their_tiles() {
         assert!(worst < bound, "{system:?}: {worst}");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// Samples of any code range (what a stream computes block by block)
+    /// are that range of the prefix's samples, on the grandparent path
+    /// (levels 2 and up) and below it.
+    #[test]
+    fn code_ranges_are_slices_of_the_prefix(
+        which in 0usize..2,
+        level in 1u32..4,
+        (start, len) in (0usize..40_000, 0usize..40_000),
+    ) {
+        let (_, tiling) = &systems()[which];
+        let capacity = tiling.capacity(level) as usize;
+        let end = (start + len).min(capacity);
+        let start = start.min(end);
+        let fraction = 0.7;
+        let mut prefix = Vec::new();
+        prop_assert!(tiling.code_order_samples(level, 0..end, fraction, 1e4, &mut prefix));
+        let mut range = vec![engine::Sample { position: DVec2::ONE, rank: 9.0 }; 3];
+        prop_assert!(tiling.code_order_samples(level, start..end, fraction, 1e4, &mut range));
+        prop_assert_eq!(&range[..], &prefix[start..]);
+    }
+}
+
+/// A stream crossing several of its blocks gives the in-memory path's
+/// samples.
+#[test]
+fn streams_across_blocks_equal_the_fast_path() {
+    for (system, tiling) in systems() {
+        let n = 700_000;
+        let fast = engine::generate(&tiling, &Uniform, n, true).unwrap();
+        let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
+        assert!(streamed == fast, "{system:?}");
+    }
+}

@@ -346,3 +346,35 @@ fn lloyd_relaxation_evens_spacing_and_keeps_the_density() {
         inside(&points)
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// Samples of any code range (what a stream computes block by block)
+    /// are that range of the prefix's samples.
+    #[test]
+    fn code_ranges_are_slices_of_the_prefix(
+        level in 0u32..6,
+        (start, len) in (0usize..250_000, 0usize..60_000),
+    ) {
+        let tiling = SphereTiling::default();
+        let capacity = tiling.capacity(level) as usize;
+        let end = (start + len).min(capacity);
+        let start = start.min(end);
+        let mut prefix = Vec::new();
+        prop_assert!(tiling.code_order_samples(level, 0..end, 0.6, 1e4, &mut prefix));
+        let mut range = Vec::new();
+        prop_assert!(tiling.code_order_samples(level, start..end, 0.6, 1e4, &mut range));
+        prop_assert_eq!(&range[..], &prefix[start..]);
+    }
+}
+
+/// A stream crossing several of its blocks gives the in-memory path's
+/// samples.
+#[test]
+fn streams_across_blocks_equal_the_fast_path() {
+    let tiling = SphereTiling::default();
+    let n = 700_000;
+    let fast = engine::generate(&tiling, &Uniform, n, true).unwrap();
+    let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
+    assert!(streamed == fast);
+}

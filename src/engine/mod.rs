@@ -358,7 +358,7 @@ where
     if let Some(stream) = density.constant().and_then(|_| stream(system, count)) {
         // constant density: the first `count` codes of one level, no recursion
         let (fraction, d) = (stream.fraction, stream.d);
-        if system.code_order_samples(stream.level, count, fraction, d, out) {
+        if system.code_order_samples(stream.level, 0..count, fraction, d, out) {
             return Ok(out);
         }
     }

@@ -1,11 +1,20 @@
-//! Uniform samples one at a time in code order: no recursion, no sort, no
-//! buffer.
+//! Uniform samples in code order, block by block: no recursion, no sort,
+//! and memory for one block whatever the count.
 
 use super::Sample;
 use crate::tiling::{code_value, Code, TileSystem};
 
-/// Uniform samples in progressive order, computed one at a time from their
-/// codes: memory stays O(depth) however many are drawn.
+/// Codes computed at a time by a [`Stream`] (8 MB of sphere samples): the
+/// systems' block code shares a block out among threads, and each block
+/// recomputes the ancestors of its codes on every level with more tiles
+/// than a block has codes, so larger blocks cost fewer ancestors a sample
+/// (see `scripts/whole-process.sh` for what streaming costs).
+const STREAM_BLOCK: usize = 1 << 18;
+
+/// Uniform samples in progressive order, computed a block of
+/// [`STREAM_BLOCK`] codes at a time ([`TileSystem::code_order_samples`]
+/// over consecutive code ranges, so they equal the in-memory path's sample
+/// for sample): memory stays one block however many are drawn.
 ///
 /// # Example
 /// ```
@@ -19,8 +28,12 @@ pub struct Stream<'a, S: TileSystem> {
     pub(super) level: u32,
     pub(super) fraction: f64,
     pub(super) d: f64,
-    next: Code,
-    end: Code,
+    /// The first code not yet in `block`.
+    next: usize,
+    end: usize,
+    block: Vec<Sample<S::Point>>,
+    /// The next sample of `block` to yield.
+    at: usize,
 }
 /// A progressive stream of `count` uniform samples, if the system finds
 /// tiles from codes (see [`TileSystem::tile_with_code`]) and `count` fits
@@ -28,8 +41,10 @@ pub struct Stream<'a, S: TileSystem> {
 ///
 /// # Example
 /// ```
-/// use tessera::{engine, tiling::sphere::SphereTiling};
-/// assert_eq!(engine::stream(&SphereTiling::default(), 10).unwrap().count(), 10);
+/// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
+/// let tiling = SphereTiling::default();
+/// let streamed: Vec<_> = engine::stream(&tiling, 100_000).unwrap().collect();
+/// assert_eq!(streamed, engine::generate(&tiling, &Uniform, 100_000, true).unwrap());
 /// ```
 pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> {
     let d = count as f64;
@@ -41,27 +56,52 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
         fraction: d / system.capacity(level),
         d,
         next: 0,
-        end: count as Code,
+        end: count,
+        block: Vec::new(),
+        at: 0,
     })
 }
+impl<S: TileSystem> Stream<'_, S> {
+    /// Refills the block with the next codes; false at the end.
+    fn refill(&mut self) -> bool {
+        if self.next >= self.end {
+            return false;
+        }
+        let codes = self.next..self.end.min(self.next.saturating_add(STREAM_BLOCK));
+        self.next = codes.end;
+        self.at = 0;
+        let (system, level, fraction, d) = (self.system, self.level, self.fraction, self.d);
+        let rank = |code: usize| code_value(code as Code) / d;
+        if !system.code_order_samples(level, codes.clone(), fraction, d, &mut self.block) {
+            // systems that find tiles only one at a time
+            self.block.clear();
+            self.block.extend(codes.map_while(|code| {
+                let tile = system.tile_with_code(level, code as Code)?;
+                Some(Sample {
+                    position: system.sample(&tile, fraction),
+                    rank: rank(code),
+                })
+            }));
+        }
+        !self.block.is_empty()
+    }
+}
+
 impl<S: TileSystem> Iterator for Stream<'_, S> {
     type Item = Sample<S::Point>;
 
+    #[inline]
     fn next(&mut self) -> Option<Self::Item> {
-        if self.next >= self.end {
+        if self.at >= self.block.len() && !self.refill() {
             return None;
         }
-        let tile = self.system.tile_with_code(self.level, self.next)?;
-        let sample = Sample {
-            position: self.system.sample(&tile, self.fraction),
-            rank: code_value(self.next) / self.d,
-        };
-        self.next += 1;
+        let sample = self.block[self.at];
+        self.at += 1;
         Some(sample)
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
-        let left = (self.end - self.next) as usize;
+        let left = self.end - self.next + (self.block.len() - self.at);
         (left, Some(left))
     }
 }

@@ -10,6 +10,7 @@ pub mod reference;
 pub mod sphere;
 
 use crate::sample::Sample;
+use std::ops::Range;
 
 /// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
 /// every system's deepest level (the sphere's level 36 has `240 * 4^36`
@@ -127,26 +128,30 @@ pub trait TileSystem: Sync {
         let _ = (level, code);
         None
     }
-    /// `f(code, tile)` for the tiles of `level` with codes `0..count`, in
-    /// code order (what a constant density accepts), or `None` when the
-    /// system cannot find tiles from codes. The default finds each by
-    /// [`TileSystem::tile_with_code`]; systems with base-A codes share the
-    /// parents of each digit block instead.
+    /// `f(code, tile)` for the tiles of `level` whose codes lie in `codes`,
+    /// in code order (a constant density accepts a prefix `0..count`; a
+    /// stream asks for consecutive ranges), or `None` when the system cannot
+    /// find tiles from codes or the range passes the level's capacity. The
+    /// default finds each by [`TileSystem::tile_with_code`]; systems with
+    /// base-A codes share the parents of each digit block instead.
     fn map_code_order<T: Send>(
         &self,
         level: u32,
-        count: usize,
+        codes: Range<usize>,
         f: &(dyn Fn(Code, &Self::Tile) -> T + Sync),
     ) -> Option<Vec<T>> {
-        (0..count as Code)
-            .map(|code| self.tile_with_code(level, code).map(|t| f(code, &t)))
+        codes
+            .map(|code| {
+                let code = code as Code;
+                self.tile_with_code(level, code).map(|t| f(code, &t))
+            })
             .collect()
     }
-    /// Writes into `out` (replacing its contents, reusing its capacity) the
-    /// samples of the tiles of `level` with codes `0..count` (what a
-    /// constant density of `d` samples per domain accepts: density
-    /// `fraction` of the level's capacity), ranked `code / d`, in code
-    /// order. False, leaving `out` unspecified, as
+    /// Writes into `out` (replacing its contents) the samples of the tiles
+    /// of `level` whose codes lie in `codes` (`0..count` is what a constant
+    /// density of `d` samples per domain accepts: density `fraction` of the
+    /// level's capacity), ranked `code / d`, in code order. False, leaving
+    /// `out` unspecified, as
     /// [`TileSystem::map_code_order`] returns `None`. The default samples
     /// every tile that method yields; systems override it to place points
     /// without building whole tiles.
@@ -156,19 +161,22 @@ pub trait TileSystem: Sync {
     /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
     /// let sphere = SphereTiling::default();
     /// let mut s = Vec::new();
-    /// assert!(sphere.code_order_samples(1, 500, 500.0 / 960.0, 500.0, &mut s));
+    /// assert!(sphere.code_order_samples(1, 0..500, 500.0 / 960.0, 500.0, &mut s));
     /// assert_eq!(s.len(), 500);
     /// assert_eq!(s[10].rank, 10.0 / 500.0);
+    /// let mut tail = Vec::new();
+    /// assert!(sphere.code_order_samples(1, 490..500, 500.0 / 960.0, 500.0, &mut tail));
+    /// assert_eq!(tail, s[490..]);
     /// ```
     fn code_order_samples(
         &self,
         level: u32,
-        count: usize,
+        codes: Range<usize>,
         fraction: f64,
         d: f64,
         out: &mut Vec<Sample<Self::Point>>,
     ) -> bool {
-        samples_in_code_order(self, level, count, fraction, d, out)
+        samples_in_code_order(self, level, codes, fraction, d, out)
     }
     /// Whether a terminal tile carries a sample. Penrose triangles only
     /// subdivide: its point tiles carry the samples.
@@ -221,20 +229,51 @@ pub(crate) fn mirror_unit(v: f64) -> f64 {
 /// ```
 /// use tessera::tiling::{samples_in_code_order, sphere::SphereTiling};
 /// let mut s = Vec::new();
-/// assert!(samples_in_code_order(&SphereTiling::default(), 0, 3, 0.0125, 3.0, &mut s));
+/// assert!(samples_in_code_order(&SphereTiling::default(), 0, 0..3, 0.0125, 3.0, &mut s));
 /// assert_eq!(s.len(), 3);
 /// ```
 pub fn samples_in_code_order<S: TileSystem + ?Sized>(
     system: &S,
     level: u32,
-    count: usize,
+    codes: Range<usize>,
     fraction: f64,
     d: f64,
     out: &mut Vec<Sample<S::Point>>,
 ) -> bool {
-    let samples = system.map_code_order(level, count, &|code, tile| Sample {
+    let samples = system.map_code_order(level, codes, &|code, tile| Sample {
         position: system.sample(tile, fraction),
         rank: code_value(code) / d,
     });
     samples.map(|samples| *out = samples).is_some()
+}
+
+/// The digit blocks of base-A codes that `codes` meets, with `m` codes a
+/// block (the parent level's tile count): each as `(digit, within)`,
+/// `within` the range's part of the block as offsets `c` of codes
+/// `digit * m + c`, which are the codes of their parents one level up.
+///
+/// # Example
+/// ```
+/// use tessera::tiling::digit_blocks;
+/// assert_eq!(digit_blocks(&(5..23), 10), vec![(0, 5..10), (1, 0..10), (2, 0..3)]);
+/// assert_eq!(digit_blocks(&(12..14), 10), vec![(1, 2..4)]);
+/// ```
+pub fn digit_blocks(codes: &Range<usize>, m: usize) -> Vec<(usize, Range<usize>)> {
+    if codes.is_empty() {
+        return Vec::new();
+    }
+    (codes.start / m..=(codes.end - 1) / m)
+        .map(|digit| {
+            let start = digit * m;
+            let within = codes.start.max(start) - start..codes.end.min(start + m) - start;
+            (digit, within)
+        })
+        .collect()
+}
+
+/// The offsets `c` that digit blocks (see [`digit_blocks`]) cover
+/// together: the parent codes they need.
+pub(crate) fn span(blocks: &[(usize, Range<usize>)]) -> Range<usize> {
+    let start = blocks.iter().map(|b| b.1.start).min().unwrap_or(0);
+    start..blocks.iter().map(|b| b.1.end).max().unwrap_or(start)
 }

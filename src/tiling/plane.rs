@@ -16,9 +16,12 @@
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::polyomino::{Lattice, Orientation, Placement, Shape};
 use crate::sample::Sample;
-use crate::tiling::{code_value, mirror_unit, samples_in_code_order, Code, TileSystem};
+use crate::tiling::{
+    code_value, digit_blocks, mirror_unit, samples_in_code_order, span, Code, TileSystem,
+};
 use glam::DVec2;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::Arc;
 
 /// Most cells a planar rep-tile may have (the size of [`PlaneRegion::cells`]).
@@ -445,6 +448,12 @@ impl PlaneTiling {
     }
 }
 
+/// The grandparent codes `k` that runs `(digit, first k, slots)` cover.
+fn span_of_runs<T>(runs: &[(usize, usize, &mut [T])]) -> Range<usize> {
+    let start = runs.iter().map(|r| r.1).min().unwrap_or(0);
+    start..runs.iter().map(|r| r.1 + r.2.len()).max().unwrap_or(start)
+}
+
 impl TileSystem for PlaneTiling {
     type Tile = PlaneTile;
     type Point = DVec2;
@@ -523,33 +532,43 @@ impl TileSystem for PlaneTiling {
     fn map_code_order<T: Send>(
         &self,
         level: u32,
-        count: usize,
+        codes: Range<usize>,
         f: &(dyn Fn(Code, &PlaneTile) -> T + Sync),
     ) -> Option<Vec<T>> {
-        if level > self.max_level || count as f64 > self.capacity(level) {
+        if level > self.max_level || codes.end as f64 > self.capacity(level) {
             return None;
         }
+        if codes.is_empty() {
+            return Some(Vec::new());
+        }
         if level == 0 {
-            let roots = self.roots_by_code[..count].iter().enumerate();
-            return Some(roots.map(|(code, t)| f(code as Code, t)).collect());
+            let roots = self.roots_by_code[codes.clone()].iter().zip(codes);
+            return Some(roots.map(|(t, code)| f(code as Code, t)).collect());
         }
         // codes `digit * m + c` share their parent with code `c` one level
-        // up: find the parents once, then every digit block from them
+        // up: find the parents once (those of every digit block the range
+        // meets), then each block's children from them
         let m = self.digit_weight[level as usize - 1] as usize;
-        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
-        let mut out = Vec::with_capacity(count);
-        for digit in 0..self.arity {
-            let start = digit * m;
-            if start >= count {
-                break;
-            }
-            let block = parents[..(count - start).min(m)].par_iter().enumerate();
-            out.par_extend(block.with_min_len(1024).map(|(c, p)| {
-                // the child carrying `digit` has code `start + c`
-                let code = (start + c) as Code;
-                let child = self.child_of_digit[p.rule as usize * self.arity + digit];
-                f(code, &self.child_coded(p, child as usize, code))
-            }));
+        let blocks = digit_blocks(&codes, m);
+        let parent_codes = span(&blocks);
+        let parents = self.map_code_order(level - 1, parent_codes.clone(), &|_, t| *t)?;
+        let mut out = Vec::with_capacity(codes.len());
+        for (digit, within) in blocks {
+            let start = digit * m + within.start;
+            let block =
+                &parents[within.start - parent_codes.start..within.end - parent_codes.start];
+            out.par_extend(
+                block
+                    .par_iter()
+                    .enumerate()
+                    .with_min_len(1024)
+                    .map(|(c, p)| {
+                        // the child carrying `digit` has code `start + c`
+                        let code = (start + c) as Code;
+                        let child = self.child_of_digit[p.rule as usize * self.arity + digit];
+                        f(code, &self.child_coded(p, child as usize, code))
+                    }),
+            );
         }
         Some(out)
     }
@@ -563,13 +582,13 @@ impl TileSystem for PlaneTiling {
     fn code_order_samples(
         &self,
         level: u32,
-        count: usize,
+        codes: Range<usize>,
         fraction: f64,
         d: f64,
         out: &mut Vec<Sample<DVec2>>,
     ) -> bool {
-        if level < 2 || level > self.max_level || count as f64 > self.capacity(level) {
-            return samples_in_code_order(self, level, count, fraction, d, out);
+        if level < 2 || level > self.max_level || codes.end as f64 > self.capacity(level) {
+            return samples_in_code_order(self, level, codes, fraction, d, out);
         }
         let (bin, s, a) = (
             self.bin(fraction),
@@ -587,7 +606,11 @@ impl TileSystem for PlaneTiling {
             .collect();
         let m1 = self.digit_weight[level as usize - 1] as usize;
         let m2 = self.digit_weight[level as usize - 2] as usize;
-        let Some(grandparents) = self.map_code_order(level - 2, count.min(m2), &|_, t| {
+        // code `q * m2 + k` (q = d * a + e) is a run of `k` per `q`; the
+        // grandparents are those of every run the range meets
+        let runs_met = digit_blocks(&codes, m2);
+        let grand_codes = span(&runs_met);
+        let Some(grandparents) = self.map_code_order(level - 2, grand_codes.clone(), &|_, t| {
             (t.placement, t.rule, t.class)
         }) else {
             return false;
@@ -597,16 +620,21 @@ impl TileSystem for PlaneTiling {
             rank: 0.0,
         };
         // (every slot is written below: only new memory needs a fill)
-        out.truncate(count);
-        out.resize(count, unset);
-        // runs[e]: the output runs of the parents of digit `e`, one per `d`
+        out.truncate(codes.len());
+        out.resize(codes.len(), unset);
+        // runs[e]: the output runs of the parents of digit `e`: per run its
+        // digit `d`, its first `k` and its slots
         let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
-        for (q, run) in out.chunks_mut(m2).enumerate() {
-            runs[q % a].push((q / a, run));
+        let mut rest = &mut out[..];
+        for (q, within) in runs_met {
+            let (run, tail) = rest.split_at_mut(within.len());
+            rest = tail;
+            runs[q % a].push((q / a, within.start, run));
         }
         runs.into_par_iter().enumerate().for_each(|(e, mut runs)| {
-            let longest = runs.iter().map(|(_, run)| run.len()).max().unwrap_or(0);
-            for (k, (placement, rule, class)) in grandparents[..longest].iter().enumerate() {
+            let ks = span_of_runs(&runs);
+            for k in ks {
+                let (placement, rule, class) = &grandparents[k - grand_codes.start];
                 // the parent: child of digit `e`
                 let child = self.child_of_digit[*rule as usize * a + e] as usize;
                 let at = *rule as usize * a + child;
@@ -615,8 +643,10 @@ impl TileSystem for PlaneTiling {
                     self.child_rule[at] as usize,
                     self.lut.transitions[*class as usize * a + child] as usize,
                 );
-                for (digit, run) in runs.iter_mut() {
-                    let Some(slot) = run.get_mut(k) else { continue };
+                for (digit, first, run) in runs.iter_mut() {
+                    let Some(slot) = k.checked_sub(*first).and_then(|i| run.get_mut(i)) else {
+                        continue;
+                    };
                     let child = self.child_of_digit[rule * a + *digit] as usize;
                     let placement = self.child_placement(&parent, rule * a + child);
                     let class = self.lut.transitions[class * a + child] as usize;

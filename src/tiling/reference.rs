@@ -87,10 +87,10 @@ impl<S: ReferencePoint> TileSystem for WithoutOffsets<S> {
     fn map_code_order<T: Send>(
         &self,
         level: u32,
-        count: usize,
+        codes: std::ops::Range<usize>,
         f: &(dyn Fn(Code, &S::Tile) -> T + Sync),
     ) -> Option<Vec<T>> {
-        self.0.map_code_order(level, count, f)
+        self.0.map_code_order(level, codes, f)
     }
     fn carries_sample(&self, tile: &S::Tile) -> bool {
         self.0.carries_sample(tile)

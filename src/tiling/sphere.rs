@@ -15,9 +15,10 @@
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
 use crate::polyomino::{Lattice, Placement, Shape};
-use crate::tiling::{code_value, Code, TileSystem};
+use crate::tiling::{code_value, digit_blocks, span, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::Arc;
 
 /// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
@@ -354,28 +355,32 @@ impl TileSystem for SphereTiling {
     fn map_code_order<T: Send>(
         &self,
         level: u32,
-        count: usize,
+        codes: Range<usize>,
         f: &(dyn Fn(Code, &SphereTile) -> T + Sync),
     ) -> Option<Vec<T>> {
-        if level > MAX_LEVEL || count as f64 > self.capacity(level) {
+        if level > MAX_LEVEL || codes.end as f64 > self.capacity(level) {
             return None;
         }
+        if codes.is_empty() {
+            return Some(Vec::new());
+        }
         if level == 0 {
-            let roots = self.roots_by_code[..count].iter().enumerate();
-            return Some(roots.map(|(code, t)| f(code as Code, t)).collect());
+            let roots = self.roots_by_code[codes.clone()].iter().zip(codes);
+            return Some(roots.map(|(t, code)| f(code as Code, t)).collect());
         }
         // codes `digit * m + c` share their parent with code `c` one level
-        // up: find the parents once, then every digit block from them
+        // up: find the parents once (those of every digit block the range
+        // meets), then each block's children from them
         let m = self.capacity(level - 1) as usize;
-        let parents = self.map_code_order(level - 1, count.min(m), &|_, t| *t)?;
-        let mut out = Vec::with_capacity(count);
-        for digit in 0..4 {
-            let start = digit * m;
-            if start >= count {
-                break;
-            }
-            let block = parents[..(count - start).min(m)].par_iter().enumerate();
-            out.par_extend(block.map(|(c, p)| {
+        let blocks = digit_blocks(&codes, m);
+        let parent_codes = span(&blocks);
+        let parents = self.map_code_order(level - 1, parent_codes.clone(), &|_, t| *t)?;
+        let mut out = Vec::with_capacity(codes.len());
+        for (digit, within) in blocks {
+            let start = digit * m + within.start;
+            let block =
+                &parents[within.start - parent_codes.start..within.end - parent_codes.start];
+            out.par_extend(block.par_iter().enumerate().map(|(c, p)| {
                 let child = self.child_of_digit[p.rule as usize][digit] as usize;
                 f((start + c) as Code, &self.subdivide(p, child))
             }));
