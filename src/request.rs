@@ -32,6 +32,21 @@ use crate::Error;
 use glam::{DVec2, DVec3};
 use std::path::Path;
 
+/// Uniform requests above this many samples always stream block by block
+/// ([`engine::stream`]) in bounded memory, in [`SphereRequest::with_points`]
+/// and [`PlaneRequest::with_points`]. Smaller ones stream only where no
+/// block rebuilds ancestor tiles ([`engine::Stream::rebuilds_ancestors`]),
+/// and are otherwise generated in memory first: at 10^7 sphere points a
+/// stream took about twice the in-memory path's CPU time on one thread
+/// (docs/PERFORMANCE.md, `scripts/whole-process.sh`). The points are the
+/// same either way.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::request::STREAM_ABOVE, 1 << 24);
+/// ```
+pub const STREAM_ABOVE: usize = 1 << 24;
+
 /// What a sphere request samples: the command line's region strings
 /// (`--density`) or a lat-long environment map (`--map`).
 ///
@@ -182,8 +197,9 @@ impl SphereRequest {
 
     /// [`SphereRequest::points`] handed to `sink` as an exact-size
     /// iterator: a uniform request (without window or relaxation) streams
-    /// block by block in bounded memory ([`engine::stream`]), others are
-    /// generated in memory first. This is how `tessera sphere` writes.
+    /// block by block in bounded memory where [`STREAM_ABOVE`] says so,
+    /// others are generated in memory first. This is how `tessera sphere`
+    /// writes.
     ///
     /// # Example
     /// ```
@@ -202,7 +218,7 @@ impl SphereRequest {
             let tiling = SphereTiling::default();
             let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
             match engine::stream(&tiling, self.count) {
-                Some(stream) if uniform => {
+                Some(stream) if uniform && worth_streaming(&stream) => {
                     // the frame of `Rotated::new(density, seed)`
                     let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
                     let mut points = stream.map(|s| match &frame {
@@ -524,8 +540,8 @@ impl PlaneRequest {
 
     /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
     /// a uniform request on the unit square without seed streams block by
-    /// block in bounded memory ([`engine::stream`]). This is how `tessera
-    /// plane` writes.
+    /// block in bounded memory where [`STREAM_ABOVE`] says so. This is how
+    /// `tessera plane` writes.
     ///
     /// # Example
     /// ```
@@ -629,7 +645,12 @@ trait StreamSource {
 
 impl<S: TileSystem<Point = DVec2>> StreamSource for S {
     fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>> {
-        let stream = engine::stream(self, count)?;
+        let stream = engine::stream(self, count).filter(worth_streaming)?;
         Some(Box::new(stream.map(|s| s.position)))
     }
+}
+
+/// Whether a uniform request streams (see [`STREAM_ABOVE`]).
+fn worth_streaming<S: TileSystem>(stream: &engine::Stream<'_, S>) -> bool {
+    stream.len() > STREAM_ABOVE || !stream.rebuilds_ancestors()
 }

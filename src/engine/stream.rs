@@ -4,12 +4,12 @@
 use super::Sample;
 use crate::tiling::{code_value, Code, TileSystem};
 
-/// Codes computed at a time by a [`Stream`] (8 MB of sphere samples): the
+/// Codes computed at a time by a [`Stream`] (2 MB of sphere samples): the
 /// systems' block code shares a block out among threads, and each block
 /// recomputes the ancestors of its codes on every level with more tiles
 /// than a block has codes, so larger blocks cost fewer ancestors a sample
 /// (see `scripts/whole-process.sh` for what streaming costs).
-const STREAM_BLOCK: usize = 1 << 18;
+const STREAM_BLOCK: usize = 1 << 16;
 
 /// Uniform samples in progressive order, computed a block of
 /// [`STREAM_BLOCK`] codes at a time ([`TileSystem::code_order_samples`]
@@ -62,6 +62,24 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
     })
 }
 impl<S: TileSystem> Stream<'_, S> {
+    /// Whether each block rebuilds ancestor tiles that no other block
+    /// shares: when the level above the stream's has more tiles than a
+    /// block has codes, a block's parents are its own (consecutive codes
+    /// have consecutive, distinct parents), and so on up every such level.
+    /// Such a stream costs more a sample than generating the whole request
+    /// at once, which builds every tile once.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{engine, tiling::sphere::SphereTiling};
+    /// let sphere = SphereTiling::default();
+    /// assert!(!engine::stream(&sphere, 100_000).unwrap().rebuilds_ancestors());
+    /// assert!(engine::stream(&sphere, 10_000_000).unwrap().rebuilds_ancestors());
+    /// ```
+    pub fn rebuilds_ancestors(&self) -> bool {
+        self.level > 0 && self.system.capacity(self.level - 1) > STREAM_BLOCK as f64
+    }
+
     /// Refills the block with the next codes; false at the end.
     fn refill(&mut self) -> bool {
         if self.next >= self.end {

@@ -210,6 +210,54 @@ impl SphereTiling {
         }
     }
 
+    /// Appends to `out` `f(code, tile)` for the tiles of `level` whose codes
+    /// lie in `codes`, in code order (codes within the level's capacity).
+    /// Codes `digit * m + c` are child `digit` of the tile of code `c` one
+    /// level up, so the parents are found once (those of every digit block
+    /// the range meets) and serve each block, whose children are built in
+    /// parallel.
+    fn extend_in_code_order<T: Send>(
+        &self,
+        level: u32,
+        codes: Range<usize>,
+        out: &mut Vec<T>,
+        f: &(dyn Fn(Code, &SphereTile) -> T + Sync),
+    ) {
+        if codes.is_empty() {
+            return;
+        }
+        if level == 0 {
+            let roots = self.roots_by_code[codes.clone()].iter().zip(codes);
+            return out.extend(roots.map(|(t, code)| f(code as Code, t)));
+        }
+        let m = self.capacity(level - 1) as usize;
+        let blocks = digit_blocks(&codes, m);
+        let parent_codes = span(&blocks);
+        let mut parents = TILE_LISTS.with(|lists| lists.borrow_mut().pop().unwrap_or_default());
+        parents.clear();
+        self.extend_in_code_order(level - 1, parent_codes.clone(), &mut parents, &|_, t| *t);
+        out.reserve(codes.len());
+        for (digit, within) in blocks {
+            let start = digit * m + within.start;
+            let block =
+                &parents[within.start - parent_codes.start..within.end - parent_codes.start];
+            let children = block.par_iter().with_min_len(4096).enumerate();
+            out.par_extend(children.map(|(c, p)| f((start + c) as Code, &self.child_of(p, digit))));
+        }
+        if parents.capacity() <= KEPT_LIST_TILES {
+            TILE_LISTS.with(|lists| lists.borrow_mut().push(parents));
+        }
+    }
+
+    /// The child of `tile` with code digit `digit`.
+    #[inline]
+    fn child_of(&self, tile: &SphereTile, digit: usize) -> SphereTile {
+        self.subdivide(
+            tile,
+            self.child_of_digit[tile.rule as usize][digit] as usize,
+        )
+    }
+
     /// Every tile of a level, in tree order (children of the first root
     /// first). `240 * 4^level` tiles: meant for small levels.
     ///
@@ -273,6 +321,20 @@ impl SphereTiling {
     pub fn shape(&self) -> &Shape {
         &self.shape
     }
+}
+
+/// The longest tile list [`TILE_LISTS`] keeps (6 MB): a stream's blocks'
+/// lists, not a large in-memory request's, which are freed.
+const KEPT_LIST_TILES: usize = 1 << 17;
+
+thread_local! {
+    /// Tile lists kept for [`SphereTiling::extend_in_code_order`]'s parents:
+    /// a stream asks for one block after another, and fresh lists cost
+    /// page faults (streaming 10^8 points spent more system time on them
+    /// than building the tiles took).
+    static TILE_LISTS: std::cell::RefCell<Vec<Vec<SphereTile>>> = const {
+        std::cell::RefCell::new(Vec::new())
+    };
 }
 
 impl TileSystem for SphereTiling {
@@ -361,30 +423,8 @@ impl TileSystem for SphereTiling {
         if level > MAX_LEVEL || codes.end as f64 > self.capacity(level) {
             return None;
         }
-        if codes.is_empty() {
-            return Some(Vec::new());
-        }
-        if level == 0 {
-            let roots = self.roots_by_code[codes.clone()].iter().zip(codes);
-            return Some(roots.map(|(t, code)| f(code as Code, t)).collect());
-        }
-        // codes `digit * m + c` share their parent with code `c` one level
-        // up: find the parents once (those of every digit block the range
-        // meets), then each block's children from them
-        let m = self.capacity(level - 1) as usize;
-        let blocks = digit_blocks(&codes, m);
-        let parent_codes = span(&blocks);
-        let parents = self.map_code_order(level - 1, parent_codes.clone(), &|_, t| *t)?;
-        let mut out = Vec::with_capacity(codes.len());
-        for (digit, within) in blocks {
-            let start = digit * m + within.start;
-            let block =
-                &parents[within.start - parent_codes.start..within.end - parent_codes.start];
-            out.par_extend(block.par_iter().enumerate().map(|(c, p)| {
-                let child = self.child_of_digit[p.rule as usize][digit] as usize;
-                f((start + c) as Code, &self.subdivide(p, child))
-            }));
-        }
+        let mut out = Vec::new();
+        self.extend_in_code_order(level, codes, &mut out, f);
         Some(out)
     }
 
