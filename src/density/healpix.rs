@@ -50,7 +50,9 @@ use std::sync::Arc;
 
 /// Face-coordinate length per radian on the sphere, anywhere on any face:
 /// the mapping's area element is the constant `pi / 3`, so it stretches no
-/// direction by less than `(pi / 3) / FACE_LIPSCHITZ`. Every point within
+/// direction by less than `(pi / 3) / FACE_LIPSCHITZ` (the true supremum
+/// is 1.5242, at the poles along the face edges, where the mapping's
+/// largest stretch is 1.5961 < `FACE_LIPSCHITZ`). Every point within
 /// `r` radians of a face point lies within `INVERSE_LIPSCHITZ * r` of it
 /// in face coordinates while the box of that half-width stays on the face.
 ///
@@ -225,7 +227,11 @@ impl HealpixMap {
                     return Err(fail(format!(
                         "pixel {k} ({} order) is {v}: NaN, infinite or negative \
                          (UNSEEN pixels would count as 0)",
-                        if scheme == Scheme::Ring { "RING" } else { "NESTED" }
+                        if scheme == Scheme::Ring {
+                            "RING"
+                        } else {
+                            "NESTED"
+                        }
                     )));
                 }
                 bad += 1;
@@ -359,7 +365,10 @@ impl Density<SphereRegion> for HealpixMap {
         if side.is_finite() {
             // a tile: the box of its cells, exact in face coordinates
             let h = side / 2.0 + MARGIN;
-            let (mut x, mut y) = ([f64::INFINITY, -f64::INFINITY], [f64::INFINITY, -f64::INFINITY]);
+            let (mut x, mut y) = (
+                [f64::INFINITY, -f64::INFINITY],
+                [f64::INFINITY, -f64::INFINITY],
+            );
             for [cx, cy] in region.cells {
                 x = [x[0].min(cx - h), x[1].max(cx + h)];
                 y = [y[0].min(cy - h), y[1].max(cy + h)];

@@ -71,7 +71,10 @@ struct Header(Vec<(String, String)>);
 
 impl Header {
     fn get(&self, key: &str) -> Option<&str> {
-        self.0.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+        self.0
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
     }
 
     /// A string value, unquoted (`''` is a quote) and right-trimmed.
@@ -324,9 +327,9 @@ fn parse_healpix(data: &[u8], field: usize) -> Result<HealpixFits, String> {
             return Err(format!("PIXTYPE = '{pixtype}': not a HEALPix map"));
         }
     }
-    let ordering = header
-        .string("ORDERING")
-        .ok_or("no ORDERING keyword (RING or NESTED): not a HEALPix map, or an incomplete header")?;
+    let ordering = header.string("ORDERING").ok_or(
+        "no ORDERING keyword (RING or NESTED): not a HEALPix map, or an incomplete header",
+    )?;
     let scheme: Scheme = ordering.parse()?;
     let nside = header
         .integer("NSIDE")
@@ -357,7 +360,9 @@ fn parse_healpix(data: &[u8], field: usize) -> Result<HealpixFits, String> {
         ));
     }
     let columns = columns(&header)?;
-    let width = columns.last().map_or(0, |c| c.offset + c.repeat * kind_size(c.kind));
+    let width = columns
+        .last()
+        .map_or(0, |c| c.offset + c.repeat * kind_size(c.kind));
     if width > row_bytes {
         return Err(format!(
             "the columns need {width} bytes a row, NAXIS1 gives {row_bytes}"

@@ -1,4 +1,5 @@
 #![allow(dead_code)]
+pub mod fits;
 pub mod plane;
 pub mod sky;
 
