@@ -18,9 +18,9 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex, OnceLock};
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::density::healpix::HealpixMap;
-use tessera::healpix::Scheme;
 use tessera::density::sphere::Cap;
 use tessera::engine::Order;
+use tessera::healpix::Scheme;
 use tessera::io::image::{Raster, ReadOptions};
 use tessera::lights::RgbMap;
 use tessera::request::{MapWarning, PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
@@ -255,10 +255,7 @@ struct HealpixArray {
     scheme: Scheme,
 }
 
-fn healpix_array(
-    array: Option<PyReadonlyArray1<'_, f64>>,
-    nest: bool,
-) -> Option<HealpixArray> {
+fn healpix_array(array: Option<PyReadonlyArray1<'_, f64>>, nest: bool) -> Option<HealpixArray> {
     array.map(|a| HealpixArray {
         values: a.as_array().to_vec(),
         scheme: if nest { Scheme::Nested } else { Scheme::Ring },
