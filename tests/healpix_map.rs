@@ -8,7 +8,7 @@
 mod common;
 
 use cdshealpix::nested;
-use common::fits::{card, healpix_cards, table_bytes, text, write_map, Column};
+use common::fits::{card, healpix_cards, partial_sky, table_bytes, text, write_map, Column};
 use glam::DVec3;
 use proptest::prelude::*;
 use std::f64::consts::TAU;
@@ -343,22 +343,7 @@ fn fits_files_read_back_as_written() {
         "{err}"
     );
     // a partial sky: PIXEL then SIGNAL, the rest UNSEEN
-    let pixels = [3.0, 40.0, 767.0];
-    let signal = [1.0, 2.0, 3.0];
-    let columns = [
-        Column {
-            name: "PIXEL",
-            kind: 'J',
-            repeat: 1,
-            values: &pixels,
-        },
-        Column {
-            name: "SIGNAL",
-            kind: 'E',
-            repeat: 1,
-            values: &signal,
-        },
-    ];
+    let columns = partial_sky(&[3.0, 40.0, 767.0], &[1.0, 2.0, 3.0]);
     let mut cards = healpix_cards("RING", 8, Some("C"));
     cards.retain(|c| !c.starts_with("INDXSCHM") && !c.starts_with("OBJECT"));
     cards.push(card("INDXSCHM", &text("EXPLICIT")));
@@ -455,22 +440,7 @@ fn broken_fits_files_are_clear_errors() {
         std::fs::write(&path, bytes).unwrap();
         assert!(read_healpix(&path, 0).is_err());
     }
-    let pixels = [3.0, 768.0];
-    let signal = [1.0, 2.0];
-    let columns = [
-        Column {
-            name: "PIXEL",
-            kind: 'J',
-            repeat: 1,
-            values: &pixels,
-        },
-        Column {
-            name: "SIGNAL",
-            kind: 'E',
-            repeat: 1,
-            values: &signal,
-        },
-    ];
+    let columns = partial_sky(&[3.0, 768.0], &[1.0, 2.0]);
     let cards = [
         healpix_cards("RING", 8, None),
         vec![card("INDXSCHM", &text("EXPLICIT"))],
@@ -530,12 +500,7 @@ fn the_command_line_samples_a_fits_map() {
     }
     .points(&SphereDensity::Healpix(map.clone()))
     .unwrap();
-    let text = String::from_utf8(out.stdout).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let rows = common::csv_rows(&out.stdout);
     assert_eq!(rows.len(), 2000);
     for (row, p) in rows.iter().zip(&expected) {
         assert_eq!(DVec3::new(row[0], row[1], row[2]), *p);

@@ -125,3 +125,22 @@ pub fn write_map(path: &Path, values: &[f64], ordering: &str, coordsys: Option<&
     let cards = healpix_cards(ordering, nside, coordsys);
     std::fs::write(path, table_bytes(&[column], &cards)).unwrap();
 }
+
+/// The columns of a partial-sky map: `PIXEL` (int32) then `SIGNAL`
+/// (float32), one value a row.
+pub fn partial_sky<'a>(pixels: &'a [f64], signal: &'a [f64]) -> [Column<'a>; 2] {
+    [
+        Column {
+            name: "PIXEL",
+            kind: 'J',
+            repeat: 1,
+            values: pixels,
+        },
+        Column {
+            name: "SIGNAL",
+            kind: 'E',
+            repeat: 1,
+            values: signal,
+        },
+    ]
+}
