@@ -19,7 +19,8 @@
 //! from a max pyramid over the NESTED quadtree (a parent holds the maximum
 //! of its four children) at the finest depth where the box spans at most
 //! three pixels a side. A bare cap (a rotated tile, [`Rotated`]) is turned
-//! into a face box by [`INVERSE_LIPSCHITZ`]; a box that leaves its face
+//! into a face box by [`INVERSE_LIPSCHITZ`] (or, on the equatorial faces,
+//! [`INVERSE_LIPSCHITZ_EQUATORIAL`]); a box that leaves its face
 //! takes the pixel holding the cap's centre and its neighbours, across
 //! seams, at a depth whose pixels are wider than the cap.
 //!
@@ -63,9 +64,36 @@ use std::sync::Arc;
 /// ```
 pub const INVERSE_LIPSCHITZ: f64 = FACE_LIPSCHITZ * 3.0 / PI;
 
+/// [`INVERSE_LIPSCHITZ`] on the four equatorial faces (4 to 7), which lie
+/// in the zone `|z| <= 2/3` where `z = 2 (x + y - 1) / 3` and `phi` is
+/// linear in `x - y`: the least stretch, `(pi / 4) sqrt 2 sin(theta)` with
+/// `sin(theta) >= sqrt 5 / 3`, is 0.8279, so 1.2079 face units per radian.
+///
+/// # Example
+/// ```
+/// use tessera::density::healpix::{INVERSE_LIPSCHITZ, INVERSE_LIPSCHITZ_EQUATORIAL};
+/// assert!(INVERSE_LIPSCHITZ_EQUATORIAL < INVERSE_LIPSCHITZ);
+/// ```
+pub const INVERSE_LIPSCHITZ_EQUATORIAL: f64 = 1.208;
+
+/// Face units per radian on `face` (see [`INVERSE_LIPSCHITZ`]).
+fn inverse_lipschitz(face: u8) -> f64 {
+    if (4..8).contains(&face) {
+        INVERSE_LIPSCHITZ_EQUATORIAL
+    } else {
+        INVERSE_LIPSCHITZ
+    }
+}
+
 /// Added to every face box (face units): a sample near a box edge, turned
 /// into a direction and back, moves by a few ulps.
 const MARGIN: f64 = 1e-12;
+
+/// The half-width (face units) of a box on `face` holding every point
+/// within `radius` radians of its centre, while the box stays on the face.
+fn reach(face: u8, radius: f64) -> f64 {
+    inverse_lipschitz(face) * radius * (1.0 + 1e-9) + MARGIN
+}
 
 /// Whether a value is healpy's `UNSEEN` (its tolerance: `1e-5` relative).
 fn is_unseen(v: f64) -> bool {
@@ -119,12 +147,15 @@ impl Pixels {
     fn cap_max(&self, centre: FacePoint, radius: f64) -> f64 {
         let top = self.levels.last().expect("depth 0 exists");
         let global = || top.iter().fold(0.0f64, |a, &b| a.max(b));
+        // the box on the centre's face, then (across faces) the neighbours
+        let on_face = reach(centre.face, radius);
         let w = INVERSE_LIPSCHITZ * radius * (1.0 + 1e-9) + MARGIN;
         if !(centre.x.is_finite() && centre.y.is_finite() && w < 1.0) {
             return global();
         }
         let (x, y) = (centre.x, centre.y);
-        if let Some(m) = self.box_max(centre.face, [x - w, x + w], [y - w, y + w]) {
+        let (xs, ys) = ([x - on_face, x + on_face], [y - on_face, y + on_face]);
+        if let Some(m) = self.box_max(centre.face, xs, ys) {
             return m;
         }
         // the finest depth (at most the map's) whose pixels are wider than
@@ -159,7 +190,8 @@ impl Pixels {
 
 /// A HEALPix map as a density on the sphere (see the [module docs](self)).
 /// Cloning is cheap (the pixels and pyramid are shared). A seeded request
-/// samples it through [`crate::density::sphere::Rotated`].
+/// samples it through [`crate::density::sphere::Rotated`], which bounds it
+/// over each tile's bounding cap.
 ///
 /// # Example
 /// ```
@@ -383,10 +415,8 @@ impl Density<SphereRegion> for HealpixMap {
     fn average(&self, region: &SphereRegion) -> f64 {
         let px = &*self.pixels;
         let cells = region.cells.iter();
-        cells
-            .map(|&[x, y]| px.at(FacePoint::new(region.face, x, y)))
-            .sum::<f64>()
-            / 5.0
+        let at = |&[x, y]: &[f64; 2]| px.at(FacePoint::new(region.face, x, y));
+        cells.map(at).sum::<f64>() / 5.0
     }
 
     fn value(&self, point: DVec3) -> f64 {
