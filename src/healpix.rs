@@ -680,3 +680,152 @@ pub fn is_three_face_corner(face: u8, corner: (bool, bool)) -> bool {
         _ => mixed,
     }
 }
+
+/// How a HEALPix map orders its `12 nside^2` pixels (the FITS keyword
+/// `ORDERING`).
+///
+/// # Example
+/// ```
+/// use tessera::healpix::Scheme;
+/// assert_eq!("NEST".parse::<Scheme>().unwrap(), Scheme::Nested);
+/// assert!("ZIGZAG".parse::<Scheme>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Scheme {
+    /// Rings of equal latitude from the north pole, each from `phi = 0`
+    /// eastwards (healpy's default).
+    #[default]
+    Ring,
+    /// The quadtree: face `f`, then the Morton code of `(i, j)`, `i` in
+    /// the even bits ([`nested_index`]).
+    Nested,
+}
+
+impl std::str::FromStr for Scheme {
+    type Err = String;
+    /// `RING`, or `NESTED` / `NEST`, in any case (FITS writers use both).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_uppercase().as_str() {
+            "RING" => Ok(Scheme::Ring),
+            "NESTED" | "NEST" => Ok(Scheme::Nested),
+            other => Err(format!("ordering '{other}': expected RING or NESTED")),
+        }
+    }
+}
+
+/// `x`'s bits spread to the even bit positions (bit `k` to bit `2k`).
+fn spread_bits(x: u64) -> u64 {
+    let mut x = x & 0xffff_ffff;
+    x = (x | (x << 16)) & 0x0000_ffff_0000_ffff;
+    x = (x | (x << 8)) & 0x00ff_00ff_00ff_00ff;
+    x = (x | (x << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+    x = (x | (x << 2)) & 0x3333_3333_3333_3333;
+    (x | (x << 1)) & 0x5555_5555_5555_5555
+}
+
+/// The NESTED index of `cell` at `nside = 2^depth` (`depth <= 29`): `face *
+/// 4^depth` plus the Morton code of `(i, j)`, `i` in the even bits (as
+/// HEALPix and `cdshealpix` number them). Out-of-range `i`, `j` are
+/// clamped into the face.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::{nested_index, Cell};
+/// assert_eq!(nested_index(Cell { face: 1, i: 0, j: 0 }, 2), 16);
+/// assert_eq!(nested_index(Cell { face: 0, i: 1, j: 0 }, 1), 1);
+/// assert_eq!(nested_index(Cell { face: 0, i: 0, j: 1 }, 1), 2);
+/// ```
+pub fn nested_index(cell: Cell, depth: u32) -> u64 {
+    let last = (1i64 << depth) - 1;
+    let (i, j) = (cell.i.clamp(0, last) as u64, cell.j.clamp(0, last) as u64);
+    let face = (cell.face % FACE_COUNT as u8) as u64;
+    (face << (2 * depth)) | spread_bits(i) | (spread_bits(j) << 1)
+}
+
+/// The cell `(face, i, j)` at `nside = 2^depth` (`depth <= 29`) of the
+/// RING index `ring` (the HEALPix ring-to-face decomposition); indices
+/// past `12 nside^2 - 1` are taken as the last pixel.
+///
+/// # Example
+/// ```
+/// use tessera::healpix::{ring_cell, Cell};
+/// // nside 1: the RING and NESTED indices are the face number
+/// assert_eq!(ring_cell(5, 0), Cell { face: 5, i: 0, j: 0 });
+/// // the first ring of nside 2 holds the north vertices of faces 0..3
+/// assert_eq!(ring_cell(2, 1), Cell { face: 2, i: 1, j: 1 });
+/// ```
+pub fn ring_cell(ring: u64, depth: u32) -> Cell {
+    let nside = 1i64 << depth;
+    let npix = 12 * nside * nside;
+    let p = (ring.min(npix as u64 - 1)) as i64;
+    let ncap = 2 * nside * (nside - 1);
+    let nl2 = 2 * nside;
+    // ring number from the north pole, position in the ring (from 1),
+    // half-pixel shift, pixels per ring per face, face
+    let (iring, iphi, kshift, nr, face) = if p < ncap {
+        let iring = (1 + (1 + 2 * p as u64).isqrt() as i64) >> 1;
+        let iphi = p + 1 - 2 * iring * (iring - 1);
+        (iring, iphi, 0, iring, (iphi - 1) / iring)
+    } else if p < npix - ncap {
+        let ip = p - ncap;
+        let tmp = ip >> (depth + 2);
+        let iring = tmp + nside;
+        let iphi = ip - tmp * 4 * nside + 1;
+        let ifm = (iphi - ((tmp + 1) >> 1) + nside - 1) >> depth;
+        let ifp = (iphi - ((nl2 + 1 - tmp) >> 1) + nside - 1) >> depth;
+        let face = match ifp.cmp(&ifm) {
+            std::cmp::Ordering::Equal => ifp | 4,
+            std::cmp::Ordering::Less => ifp,
+            std::cmp::Ordering::Greater => ifm + 8,
+        };
+        (iring, iphi, (iring + nside) & 1, nside, face)
+    } else {
+        let ip = npix - p;
+        let r = (1 + (2 * ip as u64 - 1).isqrt() as i64) >> 1;
+        let iphi = 4 * r + 1 - (ip - 2 * r * (r - 1));
+        (2 * nl2 - r, iphi, 0, r, (iphi - 1) / r + 8)
+    };
+    // the face's ring of its south vertex and longitude of its centre,
+    // in units of nside and of pi / 4
+    let irt = iring - (2 + face / 4) * nside + 1;
+    let jpll = [1, 3, 5, 7, 0, 2, 4, 6, 1, 3, 5, 7][face as usize];
+    let mut ipt = 2 * iphi - jpll * nr - kshift - 1;
+    if ipt >= nl2 {
+        ipt -= 8 * nside;
+    }
+    Cell {
+        face: face as u8,
+        i: (ipt - irt) >> 1,
+        j: (-ipt - irt) >> 1,
+    }
+}
+
+/// The cell at `nside = 2^depth` holding a face point (points on a cell
+/// edge go to the cell above it; coordinates are clamped into the face).
+///
+/// # Example
+/// ```
+/// use tessera::healpix::{cell_of, Cell, FacePoint};
+/// assert_eq!(cell_of(FacePoint::new(3, 0.3, 1.0), 2), Cell { face: 3, i: 1, j: 3 });
+/// ```
+#[inline]
+pub fn cell_of(p: FacePoint, depth: u32) -> Cell {
+    let nside = (1u64 << depth) as f64;
+    let last = (1i64 << depth) - 1;
+    // `as` saturates and sends NaN to 0
+    let index = |t: f64| ((t * nside) as i64).clamp(0, last);
+    Cell {
+        face: p.face % FACE_COUNT as u8,
+        i: index(p.x),
+        j: index(p.y),
+    }
+}
+
+/// HEALPix's marker of a pixel without data (healpy's `UNSEEN`): maps
+/// read as densities count such pixels as 0.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::healpix::UNSEEN, -1.6375e30);
+/// ```
+pub const UNSEEN: f64 = -1.6375e30;

@@ -18,6 +18,7 @@
 //! ```
 
 use crate::density::envmap::{EnvMap, Up};
+use crate::density::healpix::HealpixMap;
 use crate::density::plane::Shifted;
 use crate::density::rectangle::Rectangle;
 use crate::density::sphere::{Cap, Rotated};
@@ -48,7 +49,8 @@ use std::path::Path;
 pub const STREAM_ABOVE: usize = 1 << 24;
 
 /// What a sphere request samples: the command line's region strings
-/// (`--density`) or a lat-long environment map (`--map`).
+/// (`--density`), a lat-long environment map (`--map`) or a HEALPix map
+/// (`--healpix-map`).
 ///
 /// # Example
 /// ```
@@ -64,6 +66,9 @@ pub enum SphereDensity {
     Regions(Box<dyn Density<SphereRegion> + Send>),
     /// A lat-long map, luminance per unit solid angle.
     Map(EnvMap),
+    /// A HEALPix map (`--healpix-map`), constant per pixel per unit solid
+    /// angle.
+    Healpix(HealpixMap),
 }
 
 impl SphereDensity {
@@ -97,6 +102,7 @@ impl SphereDensity {
         move |p| match self {
             SphereDensity::Regions(density) => engine::pdf(&tiling, &**density, p),
             SphereDensity::Map(map) => map.pdf(p),
+            SphereDensity::Healpix(map) => map.pdf(p),
         }
     }
 }
@@ -182,6 +188,15 @@ impl SphereRequest {
                 };
                 let samples = self.samples(&tiling, &map)?;
                 self.finish(samples, &map, |p| map.to_world(p))
+            }
+            (SphereDensity::Healpix(map), Some(seed)) => {
+                let rotated = Rotated::new(map, seed);
+                let samples = self.samples(&tiling, &rotated)?;
+                self.finish(samples, &rotated, |p| rotated.to_world(p))
+            }
+            (SphereDensity::Healpix(map), None) => {
+                let samples = self.samples(&tiling, map)?;
+                self.finish(samples, map, |p| p)
             }
             (SphereDensity::Regions(density), Some(seed)) => {
                 let rotated = Rotated::new(&**density, seed);
@@ -283,6 +298,21 @@ pub enum MapWarning {
         /// Colour samples set to 0, when the colour was read too.
         colour_samples: Option<usize>,
     },
+    /// HEALPix pixels marked [`crate::healpix::UNSEEN`] (no data), or
+    /// left out of a partial-sky file, set to 0.
+    Unseen {
+        /// The file, or what data in memory is called.
+        name: std::path::PathBuf,
+        /// Pixels set to 0.
+        pixels: usize,
+    },
+    /// HEALPix pixels that were negative, NaN or infinite and were set to 0.
+    BadValues {
+        /// The file, or what data in memory is called.
+        name: std::path::PathBuf,
+        /// Pixels set to 0.
+        pixels: usize,
+    },
     /// A map that is not 2:1, used as a lat-long map all the same.
     NotTwoToOne {
         /// The file, or what data in memory is called.
@@ -320,6 +350,14 @@ impl MapWarning {
                 colour_samples: Some(colour),
             } => format!(
                 "{}: {pixels} pixel(s) and {colour} colour sample(s) negative, NaN or infinite, treated as 0 ({strict} refuses them)",
+                name.display()
+            ),
+            MapWarning::Unseen { name, pixels } => format!(
+                "{}: {pixels} UNSEEN pixel(s) (no data) treated as 0",
+                name.display()
+            ),
+            MapWarning::BadValues { name, pixels } => format!(
+                "{}: {pixels} negative, NaN or infinite pixel(s) treated as 0 ({strict} refuses them)",
                 name.display()
             ),
             MapWarning::NotTwoToOne {
@@ -431,6 +469,55 @@ pub fn open_light_map(
     let (map, more) = map_from_raster(path, raster, up)?;
     warnings.extend(more);
     Ok((map, rgb, warnings))
+}
+
+/// A HEALPix map's warnings: its [`crate::healpix::UNSEEN`] pixels and
+/// its bad values (negative, NaN, infinite), each set to 0.
+///
+/// # Example
+/// ```
+/// use tessera::{density::healpix::HealpixMap, healpix::{Scheme, UNSEEN}};
+/// use tessera::request::{healpix_warnings, MapWarning};
+/// let mut values = vec![1.0; 12];
+/// values[2] = UNSEEN;
+/// let map = HealpixMap::new("mem", values, Scheme::Ring, false).unwrap();
+/// let warnings = healpix_warnings("mem".as_ref(), &map);
+/// assert!(matches!(warnings[..], [MapWarning::Unseen { pixels: 1, .. }]));
+/// ```
+pub fn healpix_warnings(name: &Path, map: &HealpixMap) -> Vec<MapWarning> {
+    let mut warnings = Vec::new();
+    if map.unseen_pixels() > 0 {
+        warnings.push(MapWarning::Unseen {
+            name: name.into(),
+            pixels: map.unseen_pixels(),
+        });
+    }
+    if map.bad_pixels() > 0 {
+        warnings.push(MapWarning::BadValues {
+            name: name.into(),
+            pixels: map.bad_pixels(),
+        });
+    }
+    warnings
+}
+
+/// A HEALPix FITS map read as `tessera sphere --healpix-map FILE --field
+/// N` reads it ([`HealpixMap::open`]), with the warnings it prints.
+///
+/// # Example
+/// ```
+/// use tessera::request::open_healpix;
+/// let err = open_healpix("missing.fits".as_ref(), 0, false).err().unwrap();
+/// assert!(err.to_string().contains("missing.fits"));
+/// ```
+pub fn open_healpix(
+    path: &Path,
+    field: usize,
+    strict: bool,
+) -> Result<(HealpixMap, Vec<MapWarning>), Error> {
+    let map = HealpixMap::open(path, field, strict)?;
+    let warnings = healpix_warnings(path, &map);
+    Ok((map, warnings))
 }
 
 /// The planar tile systems of `tessera plane --system`.

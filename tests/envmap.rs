@@ -565,12 +565,7 @@ fn command_line_samples_maps_with_pdfs() {
     );
     assert!(stderr.contains("mesh ratio"), "{stderr}");
     let map = EnvMap::open(&small, &ReadOptions::default(), Up::Z).unwrap();
-    let text = String::from_utf8(out.stdout).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let rows = common::csv_rows(&out.stdout);
     assert_eq!(rows.len(), 500);
     for r in &rows {
         let d = DVec3::new(r[0], r[1], r[2]);

@@ -17,8 +17,10 @@ use rayon::prelude::*;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, OnceLock};
 use tessera::density::envmap::{EnvMap, Up};
+use tessera::density::healpix::HealpixMap;
 use tessera::density::sphere::Cap;
 use tessera::engine::Order;
+use tessera::healpix::Scheme;
 use tessera::io::image::{Raster, ReadOptions};
 use tessera::lights::RgbMap;
 use tessera::request::{MapWarning, PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
@@ -244,6 +246,22 @@ fn map_source(
     }
 }
 
+/// The name errors and warnings give a HEALPix map passed as an array.
+const HEALPIX_ARRAY: &str = "healpix array";
+
+/// A HEALPix map passed as an array, copied out of Python.
+struct HealpixArray {
+    values: Vec<f64>,
+    scheme: Scheme,
+}
+
+fn healpix_array(array: Option<PyReadonlyArray1<'_, f64>>, nest: bool) -> Option<HealpixArray> {
+    array.map(|a| HealpixArray {
+        values: a.as_array().to_vec(),
+        scheme: if nest { Scheme::Nested } else { Scheme::Ring },
+    })
+}
+
 /// How warnings name the strict option.
 const STRICT: &str = "strict=True";
 
@@ -255,10 +273,16 @@ fn messages(warnings: impl IntoIterator<Item = MapWarning>) -> Warnings {
 fn sphere_density(
     density: &[String],
     map: Option<&MapSource>,
+    healpix: Option<HealpixArray>,
     up: Up,
     channel: Option<String>,
     strict: bool,
 ) -> Result<(SphereDensity, Warnings), Error> {
+    if let Some(HealpixArray { values, scheme }) = healpix {
+        let map = HealpixMap::new(HEALPIX_ARRAY, values, scheme, strict)?;
+        let warnings = tessera::request::healpix_warnings(HEALPIX_ARRAY.as_ref(), &map);
+        return Ok((SphereDensity::Healpix(map), messages(warnings)));
+    }
     match map {
         None => Ok((SphereDensity::parse(density)?, Vec::new())),
         Some(MapSource::Ready(map)) => Ok((SphereDensity::Map(map.clone()), Vec::new())),
@@ -336,7 +360,7 @@ type Columns<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// See `tessera.sphere`.
 #[pyfunction]
-#[pyo3(signature = (n, density, map_path, map_array, map_ready, up, channel, strict, within, seed, threads, expected, unsorted, pdf, relax))]
+#[pyo3(signature = (n, density, map_path, map_array, map_ready, healpix, nest, up, channel, strict, within, seed, threads, expected, unsorted, pdf, relax))]
 #[allow(clippy::too_many_arguments)]
 fn sphere<'py>(
     py: Python<'py>,
@@ -345,6 +369,8 @@ fn sphere<'py>(
     map_path: Option<PathBuf>,
     map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
     map_ready: Option<PyRef<'py, Map>>,
+    healpix: Option<PyReadonlyArray1<'py, f64>>,
+    nest: bool,
     up: &str,
     channel: Option<String>,
     strict: bool,
@@ -358,8 +384,10 @@ fn sphere<'py>(
 ) -> PyResult<PointsOut<'py>> {
     let up = up_axis(up)?;
     let map = map_source(map_path, map_array, map_ready)?;
+    let healpix = healpix_array(healpix, nest);
     let (points, pdfs, warnings) = run(py, threads, move || {
-        let (density, warnings) = sphere_density(&density, map.as_ref(), up, channel, strict)?;
+        let (density, warnings) =
+            sphere_density(&density, map.as_ref(), healpix, up, channel, strict)?;
         let request = SphereRequest {
             count: n,
             expected,
@@ -381,7 +409,7 @@ fn sphere<'py>(
 
 /// See `tessera.pdf`.
 #[pyfunction]
-#[pyo3(signature = (directions, density, map_path, map_array, map_ready, up, channel, strict, threads))]
+#[pyo3(signature = (directions, density, map_path, map_array, map_ready, healpix, nest, up, channel, strict, threads))]
 #[allow(clippy::too_many_arguments)]
 fn pdf<'py>(
     py: Python<'py>,
@@ -390,6 +418,8 @@ fn pdf<'py>(
     map_path: Option<PathBuf>,
     map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
     map_ready: Option<PyRef<'py, Map>>,
+    healpix: Option<PyReadonlyArray1<'py, f64>>,
+    nest: bool,
     up: &str,
     channel: Option<String>,
     strict: bool,
@@ -410,8 +440,10 @@ fn pdf<'py>(
             directions[k]
         )));
     }
+    let healpix = healpix_array(healpix, nest);
     let (pdfs, warnings) = run(py, threads, move || {
-        let (density, warnings) = sphere_density(&density, map.as_ref(), up, channel, strict)?;
+        let (density, warnings) =
+            sphere_density(&density, map.as_ref(), healpix, up, channel, strict)?;
         let pdf = density.pdf();
         let pdfs: Vec<f64> = directions.par_iter().map(|&d| pdf(d)).collect();
         Ok((pdfs, warnings))
@@ -710,10 +742,10 @@ fn open_map<'py>(
     let source = map_source(map_path, map_array, None)?
         .ok_or_else(|| PyValueError::new_err("a map is a path or an array"))?;
     run(py, None, move || {
-        let (density, warnings) = sphere_density(&[], Some(&source), up, channel, strict)?;
+        let (density, warnings) = sphere_density(&[], Some(&source), None, up, channel, strict)?;
         match density {
             SphereDensity::Map(map) => Ok((Map { map }, warnings)),
-            SphereDensity::Regions(_) => unreachable!("a map source gives a map"),
+            _ => unreachable!("a map source gives a map"),
         }
     })
 }

@@ -108,16 +108,34 @@ def _warn(messages):
         _warnings.warn(message, RuntimeWarning, stacklevel=3)
 
 
-def _sphere_density(density, map, up, channel, strict):
-    if map is None:
+def _healpix(healpix, nest):
+    """A HEALPix map as a float64 vector, or None."""
+    if healpix is None:
+        if nest:
+            raise ValueError("nest applies to a HEALPix map (healpix=...)")
+        return None
+    array = np.ascontiguousarray(healpix, dtype=np.float64)
+    if array.ndim != 1:
+        raise ValueError(f"a healpix map is a vector of 12 nside**2 values; this one has shape {array.shape}")
+    return array
+
+
+def _sphere_density(density, map, up, channel, strict, healpix=None, nest=False):
+    healpix = _healpix(healpix, nest)
+    if healpix is not None:
+        if map is not None or density != "uniform":
+            raise ValueError("a healpix map replaces the density: pass one of density=, map= and healpix=")
+        if channel is not None or up != "z":
+            raise ValueError("up and channel apply to a lat-long map (map=...), not to healpix=")
+    elif map is None:
         if channel is not None or strict or up != "z":
-            raise ValueError("up, channel and strict apply to a map (map=...)")
+            raise ValueError("up, channel and strict apply to a map (map=... or healpix=...)")
     elif density != "uniform":
         raise ValueError("a map replaces the density: pass map= or density=, not both")
     elif isinstance(map, Map) and (channel is not None or strict or up != "z"):
         raise ValueError("a tessera.Map was read with its up, channel and strict: give them to Map()")
     map_path, map_array, map_ready = _map(map)
-    return _densities(density), map_path, map_array, map_ready
+    return _densities(density), map_path, map_array, map_ready, healpix
 
 
 class Map:
@@ -172,6 +190,8 @@ def sphere(
     density="uniform",
     *,
     map=None,
+    healpix=None,
+    nest=False,
     up="z",
     channel=None,
     strict=False,
@@ -206,6 +226,15 @@ def sphere(
         Row 0 is at +Z (theta = 0); column i covers phi = atan2(y, x) in
         [2 pi i / W, 2 pi (i + 1) / W). Constant per pixel per unit solid
         angle.
+    healpix : array, optional
+        Importance from a HEALPix map instead of ``density``: a vector of
+        12 nside**2 values (nside a power of two; a healpy map), RING
+        order unless ``nest``. Constant per pixel per unit solid angle, in
+        the map's frame (theta from +Z, phi = atan2(y, x), as
+        ``healpy.ang2pix``). UNSEEN pixels count as 0 with a warning, as
+        do NaN, infinite and negative ones (``strict`` refuses those).
+    nest : bool
+        The ``healpix`` map is in NESTED order.
     up : {"z", "y"}
         The map's up axis; with "y" a direction (x, y, z) is looked up as
         (z, x, y).
@@ -213,7 +242,8 @@ def sphere(
         Use this channel of the map file (e.g. "R", "Y") instead of luminance.
     strict : bool
         Refuse maps with NaN or infinite pixels, or negative ones beyond a
-        lossy codec's noise; otherwise they count as 0 (with a warning).
+        lossy codec's noise (a HEALPix map: any negative one); otherwise
+        they count as 0 (with a warning).
     within : str or (lon, lat, radius_deg), optional
         Return only the samples of the request inside this cap; only the
         tiles reaching it are visited, so a small window on a huge request
@@ -237,8 +267,6 @@ def sphere(
         spacing, but prefixes are no longer progressive and the pdf is the
         target density's.
 
-    HEALPix map densities (``healpix=``, ``nest=``) are not there yet.
-
     Returns
     -------
     points : (n, 3) ndarray, or (points, pdf) with ``pdf=True``.
@@ -255,15 +283,23 @@ def sphere(
     >>> sky = np.ones((32, 64)); sky[2, 10] = 1000.0
     >>> tessera.sphere(100, map=sky, seed=1).shape
     (100, 3)
+    >>> hot = np.ones(768); hot[300] = 1000.0  # nside 8, RING
+    >>> points = tessera.sphere(2000, healpix=hot)
+    >>> 0.5 < float((tessera.pdf(points, healpix=hot) > 1).mean()) < 0.62  # 1000 / 1767
+    True
     """
     n = _count(n)
-    specs, map_path, map_array, map_ready = _sphere_density(density, map, up, channel, strict)
+    specs, map_path, map_array, map_ready, healpix = _sphere_density(
+        density, map, up, channel, strict, healpix, nest
+    )
     points, pdfs, notes = _tessera.sphere(
         n,
         specs,
         map_path,
         map_array,
         map_ready,
+        healpix,
+        bool(nest),
         up,
         channel,
         bool(strict),
@@ -279,11 +315,24 @@ def sphere(
     return (points, pdfs) if pdf else points
 
 
-def pdf(directions, density="uniform", *, map=None, up="z", channel=None, strict=False, threads=None, **request):
+def pdf(
+    directions,
+    density="uniform",
+    *,
+    map=None,
+    healpix=None,
+    nest=False,
+    up="z",
+    channel=None,
+    strict=False,
+    threads=None,
+    **request,
+):
     """The pdf per steradian that ``sphere`` samples follow, at any directions.
 
     For multiple importance sampling: the same density options as
-    ``sphere`` (``density``, ``map``, ``up``, ``channel``, ``strict``); in a
+    ``sphere`` (``density``, ``map``, ``healpix``, ``nest``, ``up``,
+    ``channel``, ``strict``); in a
     render loop pass a ``tessera.Map``, read once.
     ``sphere``'s other options (``within``, ``seed``, ``expected``,
     ``unsorted``, ``relax``, ``n``) are accepted and do not change the pdf,
@@ -307,9 +356,11 @@ def pdf(directions, density="uniform", *, map=None, up="z", channel=None, strict
     rows = directions.reshape(1, -1) if single else directions
     if rows.ndim != 2 or rows.shape[1] != 3:
         raise ValueError(f"directions are an (n, 3) array; this one has shape {directions.shape}")
-    specs, map_path, map_array, map_ready = _sphere_density(density, map, up, channel, strict)
+    specs, map_path, map_array, map_ready, healpix = _sphere_density(
+        density, map, up, channel, strict, healpix, nest
+    )
     values, notes = _tessera.pdf(
-        rows, specs, map_path, map_array, map_ready, up, channel, bool(strict), _threads(threads)
+        rows, specs, map_path, map_array, map_ready, healpix, bool(nest), up, channel, bool(strict), _threads(threads)
     )
     _warn(notes)
     return values[0] if single else values

@@ -70,3 +70,42 @@ def sky(width=64, height=32, seed=5):
     rgb = np.stack([base * 0.8, base, base * 1.3], axis=-1) + 0.05 * rng.random((height, width, 3))
     rgb[height // 4, width // 3] = [400.0, 380.0, 300.0]
     return rgb.astype(np.float32)
+
+
+def write_healpix(path, values, nest=False, coordsys="C", dtype=">f4"):
+    """A full-sky HEALPix map in FITS as healpy's write_map lays it out: an
+    empty primary HDU, then a binary table of one column, in rows of 1024
+    values when there are more than 1024."""
+    values = np.asarray(values, dtype=dtype)
+    nside = int(round(np.sqrt(values.size / 12)))
+    repeat = 1024 if values.size > 1024 else 1
+    letter = {">f4": "E", ">f8": "D"}[dtype]
+
+    def header(cards):
+        text = "".join(f"{key:<8}= {value:<70}" for key, value in cards) + f"{'END':<80}"
+        return (text + " " * (-len(text) % 2880)).encode("ascii")
+
+    primary = header([("SIMPLE", "T"), ("BITPIX", "8"), ("NAXIS", "0"), ("EXTEND", "T")])
+    table = header(
+        [
+            ("XTENSION", "'BINTABLE'"),
+            ("BITPIX", "8"),
+            ("NAXIS", "2"),
+            ("NAXIS1", str(repeat * values.itemsize)),
+            ("NAXIS2", str(values.size // repeat)),
+            ("PCOUNT", "0"),
+            ("GCOUNT", "1"),
+            ("TFIELDS", "1"),
+            ("TTYPE1", "'TEMPERATURE'"),
+            ("TFORM1", f"'{repeat}{letter}' " if repeat > 1 else f"'{letter}'"),
+            ("PIXTYPE", "'HEALPIX '"),
+            ("ORDERING", "'NESTED  '" if nest else "'RING    '"),
+            ("COORDSYS", f"'{coordsys}'"),
+            ("NSIDE", str(nside)),
+            ("FIRSTPIX", "0"),
+            ("LASTPIX", str(values.size - 1)),
+            ("INDXSCHM", "'IMPLICIT'"),
+        ]
+    )
+    data = values.tobytes()
+    Path(path).write_bytes(primary + table + data + b"\0" * (-len(data) % 2880))

@@ -56,6 +56,34 @@ def test_map_pdf_is_the_pixel_value_over_the_integral():
     assert (tessera.pdf(points, map=rgb) == p).all()
 
 
+def test_healpix_counts_per_pixel_follow_the_map():
+    # nside 8: counts per pixel within 4 sqrt(expected) of expected, a hot
+    # pixel's share within 10 %, RING and NESTED
+    rng = np.random.default_rng(2)
+    values = 0.5 + 1.5 * rng.random(768)
+    n = 153_600
+    for nest in (False, True):
+        points, pdf = tessera.sphere(n, healpix=values, nest=nest, pdf=True)
+        assert pdf == pytest.approx(tessera.pdf(points, healpix=values, nest=nest), rel=0)
+        assert (pdf * 4 * np.pi * values.mean()) == pytest.approx(values[_pixels(points, nest)], rel=1e-12)
+        counts = np.bincount(_pixels(points, nest), minlength=768)
+        expected = n * values / values.sum()
+        assert np.abs(counts - expected).max() <= 4 * np.sqrt(expected).min()
+        hot = np.ones(768)
+        hot[300] = 1000.0
+        share = np.mean(_pixels(tessera.sphere(20_000, healpix=hot, nest=nest, seed=9), nest) == 300)
+        assert abs(share / (1000 / 1767) - 1) < 0.1
+
+
+def _pixels(points, nest):
+    """The nside-8 pixel (RING or NESTED index) of each direction, by the
+    package's own lookup: a map holding index + 1 has pdf (index + 1) /
+    (4 pi mean). (test_healpy.py checks the lookup against healpy.)"""
+    index_map = np.arange(768.0) + 1
+    p = tessera.pdf(points, healpix=index_map, nest=nest)
+    return np.rint(p * 4 * np.pi * index_map.mean()).astype(np.int64) - 1
+
+
 def test_planar_pdf_is_per_unit_area_of_the_domain():
     points, pdf = tessera.plane(2000, density="ramp", domain=(0, 0, 4, 2), pdf=True)
     # ramp: density 2 x on the unit square, stretched over a 4 x 2 rectangle

@@ -9,7 +9,7 @@ import pytest
 
 import tessera
 from conftest import read_csv, read_utk
-from maps import write_exr, write_png
+from maps import write_exr, write_healpix, write_png
 
 
 def same(a, b):
@@ -112,6 +112,31 @@ def test_map_file_and_array_are_the_cli_map(cli, sky_exr):
     write_exr(path.with_name("grey.exr"), {"Y": grey})
     expected = read_utk(cli("sphere", "-n", 2000, "--map", path.with_name("grey.exr"), "--format", "bin"))
     same(tessera.sphere(2000, map=grey), expected)
+
+
+def test_healpix_maps_are_the_cli_healpix_maps(cli, tmp_path):
+    rng = np.random.default_rng(8)
+    # nside 16 (rows of 1024 float32 in the file), a hot pixel, UNSEEN pixels
+    values = (0.2 + rng.random(3072)).astype(np.float32)
+    values[1000] = 500.0
+    values[[7, 2000]] = -1.6375e30
+    for nest in (False, True):
+        path = tmp_path / f"map-{nest}.fits"
+        write_healpix(path, values, nest=nest)
+        ordering = dict(nest=True) if nest else {}
+        for options, args in [({}, []), (dict(seed=5), ["--seed", "5"]), (dict(unsorted=True), ["--unsorted"])]:
+            header, rows = read_csv(cli("sphere", "-n", 4000, "--healpix-map", path, "--format", "csv", *args))
+            with pytest.warns(RuntimeWarning, match="2 UNSEEN pixel"):
+                points, pdf = tessera.sphere(4000, healpix=values, pdf=True, **ordering, **options)
+            same(points, rows[:, :3])
+            same(pdf, rows[:, 5])
+            with pytest.warns(RuntimeWarning, match="UNSEEN"):
+                same(tessera.pdf(points, healpix=values.astype(np.float64), **ordering), pdf)
+    # nside 8 in float64, one value a row
+    values = 1.0 + rng.random(768)
+    write_healpix(tmp_path / "d.fits", values, nest=True, dtype=">f8")
+    expected = read_utk(cli("sphere", "-n", 1500, "--healpix-map", tmp_path / "d.fits", "--format", "bin"))
+    same(tessera.sphere(1500, healpix=values, nest=True), expected)
 
 
 def test_png_map_is_the_cli_png_map(cli, tmp_path):

@@ -648,21 +648,6 @@ impl EnvMap {
     }
 }
 
-/// Side of a pentomino cell in face coordinates: the smallest step between
-/// two of its (edge-adjacent) cell centres.
-fn cell_side(cells: &[[f64; 2]; 5]) -> f64 {
-    let mut side = f64::INFINITY;
-    for a in 0..5 {
-        for b in a + 1..5 {
-            let d = (cells[a][0] - cells[b][0]).abs() + (cells[a][1] - cells[b][1]).abs();
-            if d > 0.0 {
-                side = side.min(d);
-            }
-        }
-    }
-    side
-}
-
 impl EnvMap {
     /// The maximum over the pixels a region touches, and the pixel's value
     /// when it touches only one (then the region's exact average).
@@ -684,7 +669,7 @@ impl EnvMap {
 
     /// The midpoint rule over equal-area sub-cells about a pixel row across.
     fn quadrature(&self, region: &SphereRegion) -> f64 {
-        let side = cell_side(&region.cells);
+        let side = region.cell_side();
         // pixel rows per cell side (a face side is about 1.02 rad)
         let rows = side * 1.02 / (PI / self.pixels.height as f64);
         // sub-cells at most about a pixel row across

@@ -7,6 +7,7 @@
 //! relative: only ratios matter, and the engine scales by the requested count.
 
 pub mod envmap;
+pub mod healpix;
 pub mod plane;
 pub mod rectangle;
 pub mod region;

@@ -109,6 +109,31 @@ impl SphereRegion {
         self.cells
             .map(|[x, y]| FacePoint::new(self.face, x, y).to_vec())
     }
+
+    /// Side of the tile's cells in face coordinates: the smallest step
+    /// between two (edge-adjacent) cell centres. Infinite for a bare cap
+    /// whose cells all sit at its centre (as [`crate::density::sphere::Rotated`]
+    /// passes): such a region is known only by its cap.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let tile = sphere.child(&sphere.roots()[0], 1);
+    /// assert!((sphere.region(&tile).cell_side() - 1.0 / 20.0).abs() < 1e-12);
+    /// ```
+    pub fn cell_side(&self) -> f64 {
+        let mut side = f64::INFINITY;
+        for (a, p) in self.cells.iter().enumerate() {
+            for q in &self.cells[a + 1..] {
+                let d = (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
+                if d > 0.0 {
+                    side = side.min(d);
+                }
+            }
+        }
+        side
+    }
 }
 
 /// The sphere tile system, driven by an offset table ([`SphereLut`]).

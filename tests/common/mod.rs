@@ -1,4 +1,5 @@
 #![allow(dead_code)]
+pub mod fits;
 pub mod plane;
 pub mod sky;
 
@@ -9,6 +10,15 @@ pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .build()
         .expect("a thread pool")
         .install(f)
+}
+
+/// The rows of a CSV with a header line (what `--format csv` writes).
+pub fn csv_rows(output: &[u8]) -> Vec<Vec<f64>> {
+    let text = std::str::from_utf8(output).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
 }
 
 /// Runs the `tessera` binary with `args`.

@@ -30,12 +30,23 @@ pub(crate) struct SphereArgs {
     /// `LON,LAT,RADIUS_DEG`: only the tiles reaching it are visited, so a
     /// small window on a huge request costs what the window holds. The count
     /// is the expected one (exactness is a property of the whole set).
-    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with_all = ["map", "seed", "relax"])]
+    #[arg(long, value_name = "LON,LAT,RADIUS_DEG", conflicts_with_all = ["map", "healpix_map", "seed", "relax"])]
     within: Option<String>,
     /// Importance from a lat-long map (OpenEXR, Radiance .hdr or PNG):
     /// luminance per unit solid angle, constant per pixel. Replaces --density.
     #[arg(long, conflicts_with = "density")]
     map: Option<PathBuf>,
+    /// Importance from a HEALPix map in a FITS file (the binary table healpy
+    /// writes): constant per pixel per unit solid angle; ORDERING, NSIDE
+    /// (a power of two) and COORDSYS (the frame of the output) come from
+    /// the header. UNSEEN pixels, and those a partial-sky file does not
+    /// list, count as 0 with a warning. Replaces --density.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["density", "map"])]
+    healpix_map: Option<PathBuf>,
+    /// The column of the --healpix-map to read, from 0 (healpy's `field`;
+    /// a partial-sky map's PIXEL column is not counted).
+    #[arg(long, value_name = "N", default_value_t = 0, requires = "healpix_map")]
+    field: usize,
     /// Use this channel of the map (e.g. R, Y) instead of Rec.709 luminance.
     #[arg(long, requires = "map")]
     channel: Option<String>,
@@ -45,9 +56,9 @@ pub(crate) struct SphereArgs {
     up: UpAxis,
     /// Refuse maps with NaN or infinite pixels, or negative ones beyond a
     /// lossy codec's noise (5 % of the brightest pixel within two pixels,
-    /// or 1 % of the median positive pixel). Default: count bad pixels,
-    /// warn once and treat them as 0.
-    #[arg(long, requires = "map")]
+    /// or 1 % of the median positive pixel; a HEALPix map: any negative
+    /// value). Default: count bad pixels, warn once and treat them as 0.
+    #[arg(long)]
     strict: bool,
     /// Run K density-weighted Lloyd iterations on the set (about 3.5 s an
     /// iteration for 10^6 points on two cores): spacing approaches a
@@ -71,9 +82,21 @@ pub(crate) enum UpAxis {
 pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
     use tessera::request::{SphereDensity, SphereRequest};
     let format: SphereFormat = args.format.parse()?;
-    let density = match &args.map {
-        Some(path) => SphereDensity::Map(open_map(path, &args)?),
-        None => SphereDensity::parse(&args.density)?,
+    if args.strict && args.map.is_none() && args.healpix_map.is_none() {
+        return Err(Error::Request(
+            "--strict applies to a map (--map or --healpix-map)".into(),
+        ));
+    }
+    let density = match (&args.map, &args.healpix_map) {
+        (Some(path), _) => SphereDensity::Map(open_map(path, &args)?),
+        (None, Some(path)) => {
+            let (map, warnings) = tessera::request::open_healpix(path, args.field, args.strict)?;
+            for warning in warnings {
+                eprintln!("tessera: warning: {}", warning.message("--strict"));
+            }
+            SphereDensity::Healpix(map)
+        }
+        (None, None) => SphereDensity::parse(&args.density)?,
     };
     let request = SphereRequest {
         count: args.request.count,
@@ -98,6 +121,16 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
                 "tessera: {}: integral {} (value x sr)",
                 path.display(),
                 map.integral()
+            );
+        }
+        if let (SphereDensity::Healpix(map), Some(path)) = (&density, &args.healpix_map) {
+            use tessera::density::Density;
+            let mean = Density::<tessera::tiling::sphere::SphereRegion>::mean(map);
+            eprintln!(
+                "tessera: {}: NSIDE {}, COORDSYS {}, mean {mean}",
+                path.display(),
+                map.nside(),
+                map.coordsys().unwrap_or("not given")
             );
         }
         print_report(&points);
