@@ -62,12 +62,14 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
     })
 }
 impl<S: TileSystem> Stream<'_, S> {
-    /// Whether each block rebuilds ancestor tiles that no other block
-    /// shares: when the level above the stream's has more tiles than a
-    /// block has codes, a block's parents are its own (consecutive codes
-    /// have consecutive, distinct parents), and so on up every such level.
-    /// Such a stream costs more a sample than generating the whole request
-    /// at once, which builds every tile once.
+    /// Whether each block rebuilds more than one level of ancestor tiles
+    /// that no other block shares. Where a level above the stream's has
+    /// more tiles than a block has codes, a block's ancestors on it are its
+    /// own (consecutive codes have consecutive, distinct parents), and a
+    /// stream builds them again for every block, while generating the
+    /// whole request at once builds every tile once. One such level (the
+    /// parents) costs little beside placing the samples; from two on, a
+    /// stream costs more a sample than the in-memory path.
     ///
     /// # Example
     /// ```
@@ -75,9 +77,11 @@ impl<S: TileSystem> Stream<'_, S> {
     /// let sphere = SphereTiling::default();
     /// assert!(!engine::stream(&sphere, 100_000).unwrap().rebuilds_ancestors());
     /// assert!(engine::stream(&sphere, 10_000_000).unwrap().rebuilds_ancestors());
+    /// let hexomino = tessera::tiling::plane::PlaneTiling::ghexomino();
+    /// assert!(!engine::stream(&hexomino, 10_000_000).unwrap().rebuilds_ancestors());
     /// ```
     pub fn rebuilds_ancestors(&self) -> bool {
-        self.level > 0 && self.system.capacity(self.level - 1) > STREAM_BLOCK as f64
+        self.level > 1 && self.system.capacity(self.level - 2) > STREAM_BLOCK as f64
     }
 
     /// Refills the block with the next codes; false at the end.
