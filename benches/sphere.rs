@@ -1,47 +1,70 @@
-//! Sphere throughput: tessera at uniform density against a plain spherical
-//! Fibonacci generator, both producing 10^7 points and writing the same UTK
-//! binary bytes into memory. Run: `cargo bench --bench sphere`.
+//! Sphere throughput in memory: tessera at uniform density against the
+//! spherical Fibonacci lattice, 10^7 points each into buffers kept between
+//! iterations (so no side pays for fresh pages), in one run. The library's
+//! Fibonacci (`baselines::spherical_fibonacci_into`, which reduces the
+//! azimuth in double-double) runs beside `plain_fibonacci`, the lattice
+//! written the obvious way, to check that the baseline is as fast as plain
+//! code. Whole-process timings (writing the points, against plain
+//! programs) are `scripts/whole-process.sh`. Run: `cargo bench --bench
+//! sphere`.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use glam::DVec3;
 use std::hint::black_box;
-use tessera::baselines::spherical_fibonacci;
-use tessera::io::points::{write_sphere, SphereFormat};
-use tessera::Sampler;
+use tessera::baselines::spherical_fibonacci_into;
+use tessera::density::Uniform;
+use tessera::engine::{self, Buffers, Order};
+use tessera::tiling::sphere::SphereTiling;
 
 const N: usize = 10_000_000;
 
-fn to_bytes<I>(points: I) -> Vec<u8>
-where
-    I: IntoIterator<Item = glam::DVec3>,
-    I::IntoIter: ExactSizeIterator,
-{
-    let points = points.into_iter();
-    let mut out = Vec::with_capacity(20 + 24 * points.len());
-    write_sphere(&mut out, points, SphereFormat::Bin, |_| 0.0).expect("writing to memory");
-    out
+/// `z = 1 - (2i+1)/n`, azimuth `2 pi frac(i / golden ratio)`.
+fn plain_fibonacci(n: usize, out: &mut Vec<DVec3>) {
+    let inv_phi = (5f64.sqrt() - 1.0) / 2.0;
+    out.extend((0..n).map(|i| {
+        let z = 1.0 - (2 * i + 1) as f64 / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let (s, c) = (std::f64::consts::TAU * (i as f64 * inv_phi).fract()).sin_cos();
+        DVec3::new(r * c, r * s, z)
+    }));
 }
 
 fn uniform_throughput(c: &mut Criterion) {
-    let mut group = c.benchmark_group("sphere_uniform_1e7_to_bin");
+    let mut group = c.benchmark_group("sphere_uniform_1e7_in_memory");
     group.sample_size(10);
     group.throughput(Throughput::Elements(N as u64));
-    let sampler = Sampler::sphere().count(N);
+    let tiling = SphereTiling::default();
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .expect("pool");
+        let mut buffers = Buffers::default();
         group.bench_function(format!("tessera_{threads}_thread"), |b| {
             b.iter(|| {
                 pool.install(|| {
-                    let samples = sampler.generate().expect("uniform sampling");
-                    black_box(to_bytes(samples.iter().map(|s| s.position)))
+                    let order = Order::Progressive;
+                    let samples =
+                        engine::generate_into(&tiling, &Uniform, N, true, order, &mut buffers);
+                    black_box(samples.expect("uniform sampling").len())
                 })
             })
         });
     }
+    let mut points = Vec::with_capacity(N);
     group.bench_function("fibonacci_1_thread", |b| {
-        b.iter(|| black_box(to_bytes(spherical_fibonacci(N))))
+        b.iter(|| {
+            points.clear();
+            spherical_fibonacci_into(N, |p| points.push(p));
+            black_box(points.len())
+        })
+    });
+    group.bench_function("plain_fibonacci_1_thread", |b| {
+        b.iter(|| {
+            points.clear();
+            plain_fibonacci(N, &mut points);
+            black_box(points.len())
+        })
     });
     group.finish();
 }
