@@ -12,7 +12,7 @@ use crate::tiling::{code_value, Code, TileSystem};
 const STREAM_BLOCK: usize = 1 << 16;
 
 /// Uniform samples in progressive order, computed a block of
-/// [`STREAM_BLOCK`] codes at a time ([`TileSystem::code_order_samples`]
+/// 2^16 codes at a time ([`TileSystem::code_order_samples`]
 /// over consecutive code ranges, so they equal the in-memory path's sample
 /// for sample): memory stays one block however many are drawn.
 ///
