@@ -434,8 +434,8 @@ pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) ->
     let side = 256u32;
     let grey = log_image(&spectrum.periodogram, spectrum.size);
     let grey = image::imageops::resize(&grey, side, side, image::imageops::FilterType::Nearest);
-    let radial: Vec<(f64, f64)> = (1..spectrum.radial_average.len())
-        .map(|r| (r as f64, spectrum.radial_average[r]))
+    let radial: Vec<(f64, f64)> = (1..spectrum.radial_power.len())
+        .map(|r| (r as f64, spectrum.radial_power[r]))
         .collect();
     let white = vec![(1.0, 1.0), (radial.len() as f64, 1.0)];
     let series = [

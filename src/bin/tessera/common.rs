@@ -65,9 +65,9 @@ impl System {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum Domain {
-    /// Unit vectors `x y z`: separation, cap discrepancy, Riesz energy, covering radius.
+    /// Points on the unit sphere: any sphere format tessera writes (`x y z`, lonlat, csv, geojson, bin).
     Sphere,
-    /// Points `x y` in [0,1)^2: nearest-neighbour distances, discrepancies, spectrum.
+    /// Points `x y` in the unit square: any plane format tessera writes (xy, csv, bin).
     Plane,
 }
 
@@ -123,11 +123,21 @@ where
         })
 }
 
+/// A progress bar on standard error (hidden when it is not a terminal).
 pub(crate) fn progress_bar() -> ProgressBar {
     let bar = ProgressBar::new(1);
     bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
+        ProgressStyle::with_template("{msg:>16} [{bar:40}] {percent:>3}% ({elapsed}, {eta} left)")
             .expect("static template"),
     );
     bar
+}
+
+/// The library's progress callback (stage, done, total) shown on `bar`.
+pub(crate) fn progress_to(bar: &ProgressBar) -> impl Fn(&str, u64, u64) + Sync + '_ {
+    move |stage: &str, done: u64, total: u64| {
+        bar.set_message(stage.to_string());
+        bar.set_length(total);
+        bar.set_position(done);
+    }
 }
