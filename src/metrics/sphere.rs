@@ -24,7 +24,7 @@
 
 use super::report::{quiet, Measure, Options, Progress, Report, Tally};
 use super::Dd;
-use crate::voronoi::{build_tree, cell_of, Tree3};
+use crate::voronoi::{build_tree, cell_of, spatial_order, Tree3};
 use glam::DVec3;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
@@ -71,18 +71,6 @@ fn nearest_other(tree: &Tree3, points: &[DVec3], i: usize) -> usize {
         .expect("a tree of at least two points returns another point")
 }
 
-/// Minimum geodesic distance over all pairs (unnormalised); +∞ for N < 2.
-fn min_geodesic(points: &[DVec3]) -> f64 {
-    if points.len() < 2 {
-        return f64::INFINITY;
-    }
-    let tree = build_tree(points);
-    (0..points.len())
-        .into_par_iter()
-        .map(|i| geodesic_distance(points[i], points[nearest_other(&tree, points, i)]))
-        .reduce(|| f64::INFINITY, f64::min)
-}
-
 /// Normalised separation `√N · min_{i≠j} d(x_i, x_j)` (geodesic).
 ///
 /// Each point's nearest neighbour is found with a k-d tree on the 3-D
@@ -101,10 +89,7 @@ fn min_geodesic(points: &[DVec3]) -> f64 {
 /// assert_eq!(separation(&[glam::DVec3::Z]), f64::INFINITY);
 /// ```
 pub fn separation(points: &[DVec3]) -> f64 {
-    if points.is_empty() {
-        return f64::NAN;
-    }
-    min_geodesic(points) * (points.len() as f64).sqrt()
+    neighbourhoods(points, true, false, &quiet).0 * (points.len() as f64).sqrt()
 }
 
 /// Sums over unordered pairs of the `K` values `f(x_i, x_j)`, in
@@ -119,12 +104,22 @@ fn pair_sums<const K: usize>(
         .into_par_iter()
         .map(|i| {
             let p = points[i];
-            let mut acc = [Dd::ZERO; K];
-            for &q in &points[i + 1..] {
-                acc.iter_mut().zip(f(p, q)).for_each(|(a, v)| a.add(v));
+            // four independent accumulators, so that their dependency
+            // chains overlap
+            let mut lanes = [[Dd::ZERO; K]; 4];
+            let mut chunks = points[i + 1..].chunks_exact(4);
+            for c in &mut chunks {
+                for (lane, &q) in lanes.iter_mut().zip(c) {
+                    lane.iter_mut().zip(f(p, q)).for_each(|(a, v)| a.add(v));
+                }
+            }
+            for &q in chunks.remainder() {
+                lanes[0].iter_mut().zip(f(p, q)).for_each(|(a, v)| a.add(v));
             }
             tally.add((points.len() - 1 - i) as u64);
-            acc
+            std::array::from_fn(|k| {
+                (lanes[0][k].plus(lanes[1][k])).plus(lanes[2][k].plus(lanes[3][k]))
+            })
         })
         .reduce(
             || [Dd::ZERO; K],
@@ -220,21 +215,6 @@ pub fn riesz1_normalized(points: &[DVec3]) -> f64 {
     riesz1_from(points.len(), half_energy)
 }
 
-/// Unnormalised covering radius (radians); NaN for an empty set.
-fn covering_angle(points: &[DVec3]) -> f64 {
-    let n = points.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    let tree = (n > 64).then(|| build_tree(points));
-    (0..n)
-        .into_par_iter()
-        .map_init(Vec::new, |normals, i| {
-            cell_of(points, tree.as_ref(), i, normals)
-        })
-        .reduce(|| 0.0, f64::max)
-}
-
 /// Normalised covering radius `√N · max_{y ∈ S²} min_i d(y, x_i)` (geodesic).
 ///
 /// **Exact** (up to rounding, about 1e-15 rad): the maximum is attained at a
@@ -247,7 +227,9 @@ fn covering_angle(points: &[DVec3]) -> f64 {
 /// charts of the cube map with all points, where edge interiors and the
 /// antipode are also candidates, so any input (N ≥ 1, clusters, coincident
 /// points, all points on a great circle) is handled. Cost O(N log N) for
-/// well-spread sets (O(N) per wide cell otherwise), parallel.
+/// well-spread sets (O(N) per wide cell otherwise), parallel; the cells are
+/// visited along a Morton curve, so that consecutive queries share the
+/// tree's nodes in cache.
 ///
 /// Returns NaN for an empty set and π for one point. For reference, the
 /// hexagonal lattice of the same density gives `√(8π / (3√3)) ≈ 2.199` and
@@ -262,7 +244,7 @@ fn covering_angle(points: &[DVec3]) -> f64 {
 /// assert!((c - (1.0 / 3f64.sqrt()).acos()).abs() < 1e-14);
 /// ```
 pub fn covering_radius(points: &[DVec3]) -> f64 {
-    covering_angle(points) * (points.len() as f64).sqrt()
+    neighbourhoods(points, false, true, &quiet).1 * (points.len() as f64).sqrt()
 }
 
 /// Mesh ratio `2 · covering / min distance` (both unnormalised geodesic
@@ -281,7 +263,8 @@ pub fn mesh_ratio(points: &[DVec3]) -> f64 {
     if points.len() < 2 {
         return f64::NAN;
     }
-    2.0 * covering_angle(points) / min_geodesic(points)
+    let (min_angle, cover_angle) = neighbourhoods(points, true, true, &quiet);
+    2.0 * cover_angle / min_angle
 }
 
 /// Angular power spectrum `P(l) = (1/N) Σ_{i,j} P_l(x_i · x_j)` for
@@ -484,9 +467,9 @@ impl Measure for SphereMeasure {
 }
 
 /// Smallest geodesic angle between two points and covering radius (both
-/// unnormalised, radians) in one pass sharing one k-d tree; each is
-/// computed only if asked for (NaN otherwise). Empty set: NaN, NaN; one
-/// point: +∞, π.
+/// unnormalised, radians) in one pass over one k-d tree, visiting the
+/// points in [`spatial_order`] for cache locality; each is computed only if
+/// asked for (NaN otherwise). Empty set: NaN, NaN; one point: +∞, π.
 fn neighbourhoods(points: &[DVec3], min: bool, cover: bool, progress: Progress) -> (f64, f64) {
     let n = points.len();
     match n {
@@ -494,20 +477,24 @@ fn neighbourhoods(points: &[DVec3], min: bool, cover: bool, progress: Progress) 
         1 => return (f64::INFINITY, PI),
         _ => {}
     }
-    let tree = build_tree(points);
+    let sorted: Vec<DVec3> = spatial_order(points)
+        .into_par_iter()
+        .map(|i| points[i])
+        .collect();
+    let tree = build_tree(&sorted);
     let tally = Tally::new("neighbours", n as u64, progress);
     let (min_angle, cover_angle) = (0..n)
         .into_par_iter()
         .map_init(Vec::new, |normals, i| {
-            let d = if min {
-                geodesic_distance(points[i], points[nearest_other(&tree, points, i)])
+            // the covering cell's neighbours include the nearest one
+            let (c, nearest) = if cover {
+                cell_of(&sorted, (n > 64).then_some(&tree), i, normals)
             } else {
-                f64::NAN
+                (f64::NAN, Some(nearest_other(&tree, &sorted, i)))
             };
-            let c = if cover {
-                cell_of(points, (n > 64).then_some(&tree), i, normals)
-            } else {
-                f64::NAN
+            let d = match (min, nearest) {
+                (true, Some(j)) => geodesic_distance(sorted[i], sorted[j]),
+                _ => f64::NAN,
             };
             tally.add(1);
             (d, c)
