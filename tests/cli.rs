@@ -576,3 +576,63 @@ fn metric_keys_are_documented() {
         assert!(!plot.contains(word), "plot --help mentions {word}");
     }
 }
+
+/// `sphere --report` measures angles in units of the local spacing: on a
+/// uniform request that is `metrics`' normalisation, on a refined one it
+/// reads well above the uniform normalisation's collapse.
+#[test]
+fn report_normalises_by_the_local_density() {
+    let dir = std::env::temp_dir().join(format!("tessera-report-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("s.xyz");
+    let file = file.to_str().unwrap();
+    let reported = |density: &str| {
+        let out = tessera(&[
+            "sphere",
+            "-n",
+            "3000",
+            "--density",
+            density,
+            "--report",
+            "-o",
+            file,
+        ]);
+        assert!(out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        let value = |name: &str| -> f64 {
+            let at = err
+                .find(&format!("{name} "))
+                .unwrap_or_else(|| panic!("{err}"));
+            let rest = &err[at + name.len() + 1..];
+            rest.split([',', '\n']).next().unwrap().parse().unwrap()
+        };
+        let metrics = stdout(&[
+            "metrics",
+            "sphere",
+            file,
+            "--json",
+            "--only",
+            "separation_sqrt_n,mesh_ratio",
+        ]);
+        let metrics: serde_json::Value = serde_json::from_str(&metrics).unwrap();
+        (
+            value("separation"),
+            value("mesh ratio"),
+            metrics["separation_sqrt_n"].as_f64().unwrap(),
+            metrics["mesh_ratio"].as_f64().unwrap(),
+        )
+    };
+    let (separation, mesh, uniform_separation, uniform_mesh) = reported("uniform");
+    assert!(
+        (separation - uniform_separation).abs() < 1e-4,
+        "{separation} {uniform_separation}"
+    );
+    assert!((mesh - uniform_mesh).abs() < 1e-4, "{mesh} {uniform_mesh}");
+    let (separation, mesh, uniform_separation, uniform_mesh) = reported("cap:0,90,30,16");
+    assert!(
+        separation > 2.0 * uniform_separation,
+        "{separation} {uniform_separation}"
+    );
+    assert!(mesh < 0.5 * uniform_mesh, "{mesh} {uniform_mesh}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

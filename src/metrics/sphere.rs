@@ -28,6 +28,7 @@ use crate::voronoi::{build_tree, cell_of, spatial_order, Tree3};
 use glam::DVec3;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
+use serde::Serialize;
 use std::f64::consts::PI;
 use std::num::NonZero;
 
@@ -89,7 +90,7 @@ fn nearest_other(tree: &Tree3, points: &[DVec3], i: usize) -> usize {
 /// assert_eq!(separation(&[glam::DVec3::Z]), f64::INFINITY);
 /// ```
 pub fn separation(points: &[DVec3]) -> f64 {
-    neighbourhoods(points, true, false, &quiet).0 * (points.len() as f64).sqrt()
+    neighbourhoods(points, (true, false), None, &quiet).0 * (points.len() as f64).sqrt()
 }
 
 /// Sums over unordered pairs of the `K` values `f(x_i, x_j)`, in
@@ -244,7 +245,7 @@ pub fn riesz1_normalized(points: &[DVec3]) -> f64 {
 /// assert!((c - (1.0 / 3f64.sqrt()).acos()).abs() < 1e-14);
 /// ```
 pub fn covering_radius(points: &[DVec3]) -> f64 {
-    neighbourhoods(points, false, true, &quiet).1 * (points.len() as f64).sqrt()
+    neighbourhoods(points, (false, true), None, &quiet).1 * (points.len() as f64).sqrt()
 }
 
 /// Mesh ratio `2 · covering / min distance` (both unnormalised geodesic
@@ -263,7 +264,7 @@ pub fn mesh_ratio(points: &[DVec3]) -> f64 {
     if points.len() < 2 {
         return f64::NAN;
     }
-    let (min_angle, cover_angle) = neighbourhoods(points, true, true, &quiet);
+    let (min_angle, cover_angle) = neighbourhoods(points, (true, true), None, &quiet);
     2.0 * cover_angle / min_angle
 }
 
@@ -466,11 +467,22 @@ impl Measure for SphereMeasure {
     }
 }
 
-/// Smallest geodesic angle between two points and covering radius (both
-/// unnormalised, radians) in one pass over one k-d tree, visiting the
-/// points in [`spatial_order`] for cache locality; each is computed only if
-/// asked for (NaN otherwise). Empty set: NaN, NaN; one point: +∞, π.
-fn neighbourhoods(points: &[DVec3], min: bool, cover: bool, progress: Progress) -> (f64, f64) {
+/// A point's spacing scale: angles near it are multiplied by it.
+type Scale<'a> = &'a (dyn Fn(DVec3) -> f64 + Sync);
+
+/// Smallest geodesic angle between two points and covering radius
+/// (radians) in one pass over one k-d tree, visiting the points in
+/// [`spatial_order`] for cache locality; each is computed only if asked
+/// for (NaN otherwise). With a `scale`, each nearest-neighbour angle is
+/// multiplied by the larger scale of its two ends, and each cell's radius
+/// by the scale at its farthest point. Empty set: NaN, NaN; one point:
+/// +∞, π.
+fn neighbourhoods(
+    points: &[DVec3],
+    (min, cover): (bool, bool),
+    scale: Option<Scale>,
+    progress: Progress,
+) -> (f64, f64) {
     let n = points.len();
     match n {
         0 => return (f64::NAN, f64::NAN),
@@ -483,17 +495,21 @@ fn neighbourhoods(points: &[DVec3], min: bool, cover: bool, progress: Progress) 
         .collect();
     let tree = build_tree(&sorted);
     let tally = Tally::new("neighbours", n as u64, progress);
+    let at = |x: DVec3| scale.map_or(1.0, |s| s(x));
     let (min_angle, cover_angle) = (0..n)
         .into_par_iter()
         .map_init(Vec::new, |normals, i| {
             // the covering cell's neighbours include the nearest one
             let (c, nearest) = if cover {
-                cell_of(&sorted, (n > 64).then_some(&tree), i, normals)
+                let cell = cell_of(&sorted, (n > 64).then_some(&tree), i, normals);
+                (cell.radius * at(cell.farthest), cell.nearest)
             } else {
                 (f64::NAN, Some(nearest_other(&tree, &sorted, i)))
             };
             let d = match (min, nearest) {
-                (true, Some(j)) => geodesic_distance(sorted[i], sorted[j]),
+                (true, Some(j)) => {
+                    geodesic_distance(sorted[i], sorted[j]) * at(sorted[i]).max(at(sorted[j]))
+                }
                 _ => f64::NAN,
             };
             tally.add(1);
@@ -504,6 +520,53 @@ fn neighbourhoods(points: &[DVec3], min: bool, cover: bool, progress: Progress) 
         if min { min_angle } else { f64::NAN },
         if cover { cover_angle } else { f64::NAN },
     )
+}
+
+/// Separation, covering radius and mesh ratio in units of the spacing a
+/// density asks for where they are measured (what `tessera sphere
+/// --report` prints); see [`local_spacing`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LocalSpacing {
+    /// The smallest nearest-neighbour angle times `√(4π N pdf)`, the pdf
+    /// the larger of the pair's two ends.
+    pub separation: f64,
+    /// The largest Voronoi cell radius times `√(4π N pdf)` at the cell's
+    /// farthest point (0 where the pdf is 0: no sample is owed there).
+    pub covering_radius: f64,
+    /// `2 · covering_radius / separation`.
+    pub mesh_ratio: f64,
+}
+
+/// The measures of [`LocalSpacing`] for points drawn with `pdf` (per
+/// steradian): every angle is multiplied by `√(4π N pdf)`, which is `√N`
+/// for a uniform pdf, so that a set following a density exactly reads as
+/// a uniform set of the same quality would: for a uniform pdf the fields
+/// equal [`separation`], [`covering_radius`] and [`mesh_ratio`]. A
+/// piecewise-constant density (regions, maps) measures each level in its
+/// own spacing, as `examples/geodesy.rs` does per level. Cost
+/// O(N log N) plus 3N evaluations of `pdf`.
+///
+/// ```
+/// use std::f64::consts::PI;
+/// use tessera::baselines::spherical_fibonacci;
+/// use tessera::metrics::sphere::{local_spacing, separation};
+/// let points = spherical_fibonacci(1000);
+/// let local = local_spacing(&points, |_| 1.0 / (4.0 * PI));
+/// assert!((local.separation - separation(&points)).abs() < 1e-12);
+/// ```
+pub fn local_spacing(points: &[DVec3], pdf: impl Fn(DVec3) -> f64 + Sync) -> LocalSpacing {
+    let n = points.len() as f64;
+    let scale = |x: DVec3| (4.0 * PI * n * pdf(x).max(0.0)).sqrt();
+    let (separation, covering_radius) = neighbourhoods(points, (true, true), Some(&scale), &quiet);
+    LocalSpacing {
+        separation,
+        covering_radius,
+        mesh_ratio: if points.len() < 2 {
+            f64::NAN
+        } else {
+            2.0 * covering_radius / separation
+        },
+    }
 }
 
 /// The measures `options` ask for (all by default, the O(N²) ones only up
@@ -528,8 +591,11 @@ pub fn measure(points: &[DVec3], options: &Options<SphereMeasure>) -> Report<Sph
     let computes = |m| options.computes(m, n);
     let (min_angle, cover_angle) = neighbourhoods(
         points,
-        computes(Separation) || computes(MeshRatio),
-        computes(Covering) || computes(MeshRatio),
+        (
+            computes(Separation) || computes(MeshRatio),
+            computes(Covering) || computes(MeshRatio),
+        ),
+        None,
         options.progress,
     );
     // one pass for both sums, each only if asked for

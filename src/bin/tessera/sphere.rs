@@ -57,7 +57,9 @@ pub(crate) struct SphereArgs {
     #[arg(long, value_name = "K", default_value_t = 0)]
     relax: usize,
     /// Print the set's separation, covering radius and mesh ratio (and a
-    /// map's integral) to standard error.
+    /// map's integral) to standard error, each angle in units of the local
+    /// spacing the density asks for: times sqrt(4 pi N pdf), which is
+    /// sqrt(N) for a uniform request (see `tessera metrics --help`).
     #[arg(long)]
     report: bool,
 }
@@ -100,7 +102,7 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
                 map.integral()
             );
         }
-        print_report(&points);
+        print_report(&points, &pdf);
         write(&mut points.into_iter())
     } else {
         request.with_points(&density, write)?
@@ -121,16 +123,17 @@ fn open_map(path: &Path, args: &SphereArgs) -> Result<tessera::density::envmap::
     Ok(map)
 }
 
-/// Separation, covering radius and mesh ratio of a point set (the O(N log N)
-/// measures of `tessera::metrics::sphere`), to standard error.
-pub(crate) fn print_report(points: &[glam::DVec3]) {
-    use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
+/// Separation, covering radius and mesh ratio of a request's points in
+/// units of the spacing its density asks for, to standard error.
+fn print_report(points: &[glam::DVec3], pdf: &(dyn Fn(glam::DVec3) -> f64 + Sync)) {
+    let local = tessera::metrics::sphere::local_spacing(points, pdf);
     eprintln!(
-        "tessera: {} points: separation {:.4}, covering radius x sqrt(N) {:.4}, mesh ratio {:.4}",
+        "tessera: {} points, angles x sqrt(4 pi N pdf) (sqrt(N) for a uniform request): \
+         separation {:.4}, covering radius {:.4}, mesh ratio {:.4}",
         points.len(),
-        separation(points),
-        covering_radius(points),
-        mesh_ratio(points)
+        local.separation,
+        local.covering_radius,
+        local.mesh_ratio
     );
 }
 
