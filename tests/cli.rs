@@ -636,3 +636,69 @@ fn report_normalises_by_the_local_density() {
     assert!(mesh < 0.5 * uniform_mesh, "{mesh} {uniform_mesh}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `plot sphere --over MAP` draws the samples of a map over the map in its
+/// own convention: the samples of a map bright only in one block land on
+/// that block's pixels; `--over` refuses the plane and the ortho view.
+#[test]
+fn plot_over_a_map_lines_up_with_the_map() {
+    let dir = std::env::temp_dir().join(format!("tessera-over-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (width, height) = (64usize, 32usize);
+    let block = |i: usize, j: usize| (8..12).contains(&i) && (12..20).contains(&j);
+    let rgb: Vec<[f32; 3]> = (0..width * height)
+        .map(|k| {
+            if block(k % width, k / width) {
+                [5.0; 3]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let map = dir.join("block.exr");
+    common::sky::write_exr(
+        &map,
+        width,
+        height,
+        &rgb,
+        false,
+        false,
+        exr::prelude::Compression::Uncompressed,
+    );
+    let (map, points, png) = (
+        map.to_str().unwrap(),
+        dir.join("p.xyz"),
+        dir.join("over.png"),
+    );
+    let (points, png) = (points.to_str().unwrap(), png.to_str().unwrap());
+    stdout(&["sphere", "--map", map, "-n", "40", "-o", points]);
+    stdout(&[
+        "plot", "sphere", points, "--over", map, "--png", png, "--size", "640",
+    ]);
+    let img = image::open(png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (640, 320));
+    let red: Vec<(u32, u32)> = img
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p.0 == [255, 0, 0])
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(!red.is_empty());
+    // the block covers output columns 80..120 and rows 120..200 (3x3 dots
+    // may reach one pixel beyond)
+    for (x, y) in red {
+        assert!(
+            (79..=120).contains(&x) && (119..=200).contains(&y),
+            "red at {x},{y}"
+        );
+    }
+    for args in [["plane", points], ["sphere", points]] {
+        let mut cmd = vec!["plot", args[0], args[1], "--over", map, "--png", png];
+        if args[0] == "sphere" {
+            cmd.extend(["--view", "ortho"]);
+        }
+        let out = tessera(&cmd);
+        assert_eq!(out.status.code(), Some(2), "{cmd:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--over"));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

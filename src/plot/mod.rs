@@ -14,6 +14,8 @@
 
 pub mod svg;
 
+use crate::density::envmap::Up;
+use crate::lights::RgbMap;
 use glam::{DVec2, DVec3};
 use image::{GrayImage, Luma, Rgb, RgbImage};
 use std::f64::consts::{PI, TAU};
@@ -102,26 +104,127 @@ pub fn stipple(points: &[DVec2], size: u32) -> GrayImage {
     img
 }
 
-/// Equirectangular view of points on the unit sphere, `width x width/2`:
-/// longitude `atan2(y, x)` from −180° (left edge) to 180°, colatitude from
-/// the north pole `+z` (top row) to the south pole.
+/// Pixel `(column, row)` of direction `m` (map frame, +Z up) in a
+/// `width x height` lat-long image with the map convention of
+/// [`EnvMap`](crate::density::envmap): `phi = atan2(y, x) mod 2π` from 0 at
+/// the left edge, `theta` from +Z at the top row.
+fn lat_long_pixel(m: DVec3, width: u32, height: u32) -> (i64, i64) {
+    // + 0 turns −0 into +0: the poles at phi = 0
+    let phi = (m.y + 0.0).atan2(m.x + 0.0).rem_euclid(TAU);
+    let theta = m.z.clamp(-1.0, 1.0).acos();
+    (pixel(phi / TAU, width), pixel(theta / PI, height))
+}
+
+/// Equirectangular view of points on the unit sphere, `width x width/2`,
+/// in the lat-long map convention (column 0 at `phi = atan2(y, x) = 0`,
+/// phi growing to the right; the north pole `+z` at the top row), so that
+/// it lines up with the map a set was drawn from (see [`over_map`]).
 ///
 /// # Example
 /// ```
 /// use glam::DVec3;
-/// let img = tessera::plot::equirectangular(&[DVec3::X, DVec3::Z], 200);
+/// let img = tessera::plot::equirectangular(&[DVec3::X, DVec3::Z, -DVec3::X], 200);
 /// assert_eq!(img.dimensions(), (200, 100));
-/// assert_eq!(img.get_pixel(100, 50)[0], 0); // +x: longitude 0 on the equator
-/// assert_eq!(img.get_pixel(100, 0)[0], 0); // the north pole
+/// assert_eq!(img.get_pixel(0, 50)[0], 0); // +x: phi 0, the left edge, on the equator
+/// assert_eq!(img.get_pixel(100, 50)[0], 0); // −x: phi = π, the middle
+/// assert_eq!(img.get_pixel(0, 0)[0], 0); // the north pole
 /// ```
 pub fn equirectangular(points: &[DVec3], width: u32) -> GrayImage {
     let height = (width / 2).max(1);
     let (mut img, radius) = canvas(width, height, points.len());
     for p in points.iter().filter(|p| p.is_finite()) {
-        let lon = (p.y + 0.0).atan2(p.x + 0.0); // + 0 turns −0 into +0: the poles at longitude 0
-        let colat = p.z.clamp(-1.0, 1.0).acos();
-        let (col, row) = (pixel((lon + PI) / TAU, width), pixel(colat / PI, height));
+        let (col, row) = lat_long_pixel(*p, width, height);
         dot(&mut img, col, row, radius, BLACK);
+    }
+    img
+}
+
+/// A lat-long map for display, `width x width/2`: each output pixel the
+/// mean of the map pixels it covers, scaled so that the mean luminance
+/// reads 0.18 (the map's level, whatever its units), compressed by
+/// Reinhard's `v / (1 + v)` per channel and encoded as sRGB.
+///
+/// # Example
+/// ```
+/// use tessera::lights::RgbMap;
+/// let map = RgbMap { width: 4, height: 2, rgb: vec![[2.0, 2.0, 2.0]; 8], bad_samples: 0 };
+/// let img = tessera::plot::tone_map(&map, 8);
+/// assert_eq!(img.dimensions(), (8, 4));
+/// // 0.18 / (1 + 0.18) in sRGB
+/// assert!(img.pixels().all(|p| p.0 == [109, 109, 109]));
+/// ```
+pub fn tone_map(map: &RgbMap, width: u32) -> RgbImage {
+    let height = (width / 2).max(1);
+    let luminance = map.luminance();
+    let mean = luminance.iter().sum::<f64>() / luminance.len().max(1) as f64;
+    let scale = if mean > 0.0 { 0.18 / mean } else { 1.0 };
+    let srgb = |v: f64| {
+        let v = (v / (1.0 + v)).clamp(0.0, 1.0);
+        let e = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (e * 255.0).round() as u8
+    };
+    // the map pixels [lo, hi) an output pixel k of n covers
+    let span = |k: u32, n: u32, len: usize| {
+        let lo = k as usize * len / n as usize;
+        (
+            lo,
+            (((k + 1) as usize * len).div_ceil(n as usize))
+                .max(lo + 1)
+                .min(len),
+        )
+    };
+    RgbImage::from_fn(width, height, |x, y| {
+        let (c0, c1) = span(x, width, map.width);
+        let (r0, r1) = span(y, height, map.height);
+        let mut sum = [0.0f64; 3];
+        for row in r0..r1 {
+            for p in &map.rgb[row * map.width + c0..row * map.width + c1] {
+                (0..3).for_each(|c| sum[c] += f64::from(p[c]).max(0.0));
+            }
+        }
+        let count = ((r1 - r0) * (c1 - c0)).max(1) as f64;
+        Rgb(sum.map(|v| srgb(v / count * scale)))
+    })
+}
+
+/// Samples drawn over the map they were drawn from: the [`tone_map`] of
+/// `map` (`width x width/2`) with each point a red dot (3x3, outlined in
+/// black, when there are at least 64 pixels a point) at its map pixel;
+/// `up` is the map's up axis, as when sampling it.
+///
+/// # Example
+/// ```
+/// use glam::DVec3;
+/// use tessera::{density::envmap::Up, lights::RgbMap};
+/// let map = RgbMap { width: 8, height: 4, rgb: vec![[1.0; 3]; 32], bad_samples: 0 };
+/// let img = tessera::plot::over_map(&[DVec3::X], &map, Up::Z, 64);
+/// assert_eq!(img.get_pixel(1, 16).0, [255, 0, 0]); // phi 0 on the equator
+/// ```
+pub fn over_map(points: &[DVec3], map: &RgbMap, up: Up, width: u32) -> RgbImage {
+    let mut img = tone_map(map, width);
+    let (w, h) = img.dimensions();
+    let big = (w as usize * h as usize) >= 64 * points.len().max(1);
+    let pixels: Vec<(i64, i64)> = points
+        .iter()
+        .filter(|p| p.is_finite())
+        .map(|p| lat_long_pixel(up.to_map(*p), w, h))
+        .collect();
+    if big {
+        for &(col, row) in &pixels {
+            for (dx, dy) in (-2..=2).flat_map(|dx| (-2..=2).map(move |dy| (dx, dy))) {
+                put(&mut img, col + dx, row + dy, [0, 0, 0]);
+            }
+        }
+    }
+    let r = i64::from(big);
+    for &(col, row) in &pixels {
+        for (dx, dy) in (-r..=r).flat_map(|dx| (-r..=r).map(move |dy| (dx, dy))) {
+            put(&mut img, col + dx, row + dy, [255, 0, 0]);
+        }
     }
     img
 }

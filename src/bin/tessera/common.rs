@@ -71,6 +71,22 @@ pub(crate) enum Domain {
     Plane,
 }
 
+/// A map's up axis (`--up`).
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum UpAxis {
+    Z,
+    Y,
+}
+
+impl From<UpAxis> for tessera::density::envmap::Up {
+    fn from(up: UpAxis) -> Self {
+        match up {
+            UpAxis::Z => tessera::density::envmap::Up::Z,
+            UpAxis::Y => tessera::density::envmap::Up::Y,
+        }
+    }
+}
+
 pub(crate) fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
     if path == Path::new("-") {
         return Ok(Box::new(std::io::BufWriter::new(std::io::stdout().lock())));

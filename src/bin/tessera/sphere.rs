@@ -2,7 +2,7 @@
 
 use crate::common::*;
 use clap::builder::PossibleValuesParser;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use tessera::density::sphere::Cap;
@@ -62,12 +62,6 @@ pub(crate) struct SphereArgs {
     /// sqrt(N) for a uniform request (see `tessera metrics --help`).
     #[arg(long)]
     report: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-pub(crate) enum UpAxis {
-    Z,
-    Y,
 }
 
 pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
@@ -135,13 +129,4 @@ fn print_report(points: &[glam::DVec3], pdf: &(dyn Fn(glam::DVec3) -> f64 + Sync
         local.covering_radius,
         local.mesh_ratio
     );
-}
-
-impl From<UpAxis> for tessera::density::envmap::Up {
-    fn from(up: UpAxis) -> Self {
-        match up {
-            UpAxis::Z => tessera::density::envmap::Up::Z,
-            UpAxis::Y => tessera::density::envmap::Up::Y,
-        }
-    }
 }
