@@ -249,7 +249,7 @@ fn plot_and_metrics_png() {
         ("eq.png", (200, 100)),
         ("o.png", (120, 120)),
         ("st.png", (128, 128)),
-        ("ps.png", (768, 256)),
+        ("ps.png", (768, 280)),
         ("ap.png", (640, 360)),
     ] {
         let img = image::open(dir.join(name)).unwrap();

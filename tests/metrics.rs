@@ -1000,3 +1000,20 @@ fn random_baselines() {
         .iter()
         .all(|q| (0.0..1.0).contains(&q.x) && (0.0..1.0).contains(&q.y)));
 }
+
+/// The plane spectrum's rings reach twice the blue-noise peak: a 50 x 50
+/// jittered grid peaks at its lattice frequency |k| = 50, inside the first
+/// half of the rings.
+#[test]
+fn plane_spectrum_reaches_twice_the_peak() {
+    let s = tessera::metrics::plane::PlaneSpectrum::new(&jittered_grid_2d(50, 3));
+    assert!(
+        s.radial_power.len() as f64 >= 2.0 * 1.07 * 50.0,
+        "{}",
+        s.size
+    );
+    let peak = (1..s.radial_power.len())
+        .max_by(|&a, &b| s.radial_power[a].total_cmp(&s.radial_power[b]))
+        .unwrap();
+    assert!((48..=52).contains(&peak), "peak at {peak}");
+}

@@ -674,6 +674,15 @@ pub fn plane_report(points: &[DVec2]) -> Report<PlaneMeasure> {
     measure(points, &options)
 }
 
+/// Above this many points, [`PlaneSpectrum`] measures a corner window
+/// holding about this many (its grid then reaches twice the blue-noise
+/// peak at a bounded cost, O(N · size²) with size ≈ 4.4 √N).
+///
+/// ```
+/// assert_eq!(tessera::metrics::plane::SPECTRUM_POINTS, 20_000);
+/// ```
+pub const SPECTRUM_POINTS: usize = 20_000;
+
 /// The periodogram of a point set on a grid sized to it, with its radial
 /// average and anisotropy (what `tessera metrics plane --spectrum` prints).
 ///
@@ -686,8 +695,14 @@ pub fn plane_report(points: &[DVec2]) -> Report<PlaneMeasure> {
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PlaneSpectrum {
-    /// Side of the frequency grid.
+    /// Side of the frequency grid: frequencies `|kx|, |ky| ≤ size / 2`.
     pub size: usize,
+    /// Side of the square `[0, window)²` measured, rescaled to the unit
+    /// square: 1 up to [`SPECTRUM_POINTS`] points, then the corner holding
+    /// about that many (frequencies are then in the window's units).
+    pub window: f64,
+    /// Number of points measured (those in the window).
+    pub points: usize,
     /// [`periodogram`] on the grid.
     pub periodogram: Vec<f64>,
     /// [`radial_average`] of it: the mean power of each ring of integer
@@ -698,14 +713,17 @@ pub struct PlaneSpectrum {
 }
 
 impl PlaneSpectrum {
-    /// The spectrum on a grid of side `4√N` rounded up to a power of two,
-    /// between 32 and 256 (twice the blue-noise peak's radius `√N/2`...`√N`
-    /// fits); cost O(N · size²).
+    /// The spectrum on a grid of side `2 ⌈2.2 √N⌉` (at least 32), so that
+    /// its rings reach twice the blue-noise peak (near `|k| = 1.07 √N`, the
+    /// first ring of the hexagonal lattice of N points); above
+    /// [`SPECTRUM_POINTS`] points, of the corner window holding about that
+    /// many. Cost O(N · size²).
     ///
     /// ```
     /// use tessera::baselines::jittered_grid_2d;
     /// use tessera::metrics::plane::PlaneSpectrum;
-    /// assert_eq!(PlaneSpectrum::new(&jittered_grid_2d(16, 1)).size, 64);
+    /// let s = PlaneSpectrum::new(&jittered_grid_2d(16, 1));
+    /// assert_eq!((s.size, s.window, s.points), (72, 1.0, 256));
     /// ```
     pub fn new(points: &[DVec2]) -> Self {
         Self::with_progress(points, &quiet)
@@ -721,16 +739,27 @@ impl PlaneSpectrum {
     /// let s = PlaneSpectrum::with_progress(&jittered_grid_2d(16, 1), &|stage, _, _| {
     ///     told.store(stage == "spectrum", std::sync::atomic::Ordering::Relaxed);
     /// });
-    /// assert!(told.into_inner() && s.size == 64);
+    /// assert!(told.into_inner() && s.size == 72);
     /// ```
     pub fn with_progress(points: &[DVec2], progress: Progress) -> Self {
-        let size = ((4.0 * (points.len() as f64).sqrt()).ceil() as usize)
-            .next_power_of_two()
-            .clamp(32, 256);
-        let tally = Tally::new("spectrum", points.len() as u64, progress);
-        let periodogram = periodogram_with(points, size, &tally);
+        let n = points.len();
+        let window = if n > SPECTRUM_POINTS {
+            (SPECTRUM_POINTS as f64 / n as f64).sqrt()
+        } else {
+            1.0
+        };
+        let kept: Vec<DVec2> = points
+            .iter()
+            .filter(|p| window == 1.0 || (p.x < window && p.y < window))
+            .map(|p| *p / window)
+            .collect();
+        let size = (2 * (2.2 * (kept.len() as f64).sqrt()).ceil() as usize).max(32);
+        let tally = Tally::new("spectrum", kept.len() as u64, progress);
+        let periodogram = periodogram_with(&kept, size, &tally);
         PlaneSpectrum {
             size,
+            window,
+            points: kept.len(),
             radial_power: radial_average(&periodogram, size),
             anisotropy_db: anisotropy(&periodogram, size),
             periodogram,

@@ -21,7 +21,9 @@ pub(crate) struct MetricsArgs {
     #[arg(long, value_name = "KEY,...")]
     only: Option<String>,
     /// Also print the spectrum: `angular_power`, P(l) for l = 0..64
-    /// (sphere), or `radial_power` and `anisotropy_db` per ring (plane).
+    /// (sphere), or `radial_power` and `anisotropy_db` per ring (plane; out
+    /// to twice the blue-noise peak, of a corner window holding 20000
+    /// points above that many).
     #[arg(long)]
     spectrum: bool,
     /// Write a PNG: the angular power spectrum plot (sphere), or the
@@ -94,6 +96,15 @@ pub(crate) fn metrics(args: MetricsArgs) -> Result<(), Error> {
             let mut spectrum = Vec::new();
             if spectral {
                 let s = plane::PlaneSpectrum::with_progress(&points, &progress);
+                if s.window < 1.0 {
+                    eprintln!(
+                        "tessera: {}: the spectrum is that of the {} points in [0, {:.4})^2, rescaled to the unit square (above {} points)",
+                        args.file.display(),
+                        s.points,
+                        s.window,
+                        plane::SPECTRUM_POINTS
+                    );
+                }
                 save_figure(&args, || plot::plane_spectrum_figure(&s))?;
                 spectrum.push(("radial_power", s.radial_power));
                 spectrum.push(("anisotropy_db", s.anisotropy_db));
