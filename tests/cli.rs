@@ -702,3 +702,51 @@ fn plot_over_a_map_lines_up_with_the_map() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--table FILE` samples with a table read at run time: the table `lut
+/// build` writes with the shipped options gives the built-in points, a
+/// table built otherwise gives others, and a table of another system is
+/// refused naming the file.
+#[test]
+fn a_rebuilt_table_is_used_without_recompiling() {
+    let dir = std::env::temp_dir().join(format!("tessera-table-{}", std::process::id()));
+    let (same, other) = (dir.join("same"), dir.join("other"));
+    for (out, extra) in [
+        (&same, &[][..]),
+        (&other, &["--iterations", "1", "--seed", "2"][..]),
+    ] {
+        let mut args = vec![
+            "lut",
+            "build",
+            "--system",
+            "ppentomino",
+            "--out-dir",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        stdout(&args);
+    }
+    let points = |table: Option<&std::path::Path>| {
+        let mut args = vec!["plane", "--system", "ppentomino", "-n", "1000"];
+        if let Some(t) = table {
+            args.extend(["--table", t.to_str().unwrap()]);
+        }
+        stdout(&args)
+    };
+    let built_in = points(None);
+    assert_eq!(points(Some(&same.join("ppentomino.lut"))), built_in);
+    assert_ne!(points(Some(&other.join("ppentomino.lut"))), built_in);
+    let table = same.join("ppentomino.lut");
+    for system in [
+        ["plane", "--system", "ghexomino"],
+        ["sphere", "--seed", "1"],
+    ] {
+        let mut args = system.to_vec();
+        args.extend(["-n", "10", "--table", table.to_str().unwrap()]);
+        let out = tessera(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("ppentomino.lut: not a"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

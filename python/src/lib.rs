@@ -367,6 +367,7 @@ fn sphere<'py>(
             seed,
             within: within.as_deref().map(Cap::window).transpose()?,
             relax,
+            table: None,
         };
         let points = request.points(&density)?;
         let pdfs = pdf.then(|| {
@@ -476,6 +477,7 @@ fn plane<'py>(
                 .as_deref()
                 .map(tessera::density::rectangle::Rectangle::parse)
                 .transpose()?,
+            table: None,
         };
         let points = request.points(&*density)?;
         let pdfs = pdf.then(|| {

@@ -28,9 +28,24 @@ pub(crate) struct RequestArgs {
     /// over seeds are unbiased; without it the output is deterministic.
     #[arg(long)]
     pub(crate) seed: Option<u64>,
+    /// Sample with this table (a `.lut` file `tessera lut build` wrote)
+    /// instead of the one built in: a rebuilt table without recompiling.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) table: Option<PathBuf>,
 }
 
 impl RequestArgs {
+    /// The `--table` file, read as a table of `system`.
+    pub(crate) fn table(
+        &self,
+        system: tessera::lut::TableSystem,
+    ) -> Result<Option<tessera::lut::Table>, Error> {
+        self.table
+            .as_deref()
+            .map(|path| tessera::lut::Table::open(path, system))
+            .transpose()
+    }
+
     /// `--unsorted` as an output order.
     pub(crate) fn order(&self) -> Order {
         if self.unsorted {

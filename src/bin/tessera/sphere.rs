@@ -78,6 +78,7 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
         seed: args.request.seed,
         within: args.within.as_deref().map(Cap::window).transpose()?,
         relax: args.relax,
+        table: args.request.table(tessera::lut::TableSystem::Sphere)?,
     };
     let pdf = density.pdf();
     let output = &args.request.output;
