@@ -8,15 +8,17 @@
 //! a 10-degree cap around Iceland 36 times denser. It prints the minimum
 //! distance within each density level in units of the local spacing, and
 //! the whole set's separation, covering radius and mesh ratio next to a
-//! uniform (spherical Fibonacci) set of the same size, and the local
-//! separation near and away from the edge of a single refined cap.
+//! uniform (spherical Fibonacci) set of the same size, the same three in
+//! units of the local spacing (`metrics::sphere::local_spacing`, what
+//! `tessera sphere --report` prints), and the local separation near and
+//! away from the edge of a single refined cap.
 
 use glam::DVec3;
 use tessera::baselines::spherical_fibonacci;
 use tessera::density::region::Regions;
 use tessera::density::Density;
 use tessera::io::points::{write_sphere, SphereFormat};
-use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
+use tessera::metrics::sphere::{covering_radius, local_spacing, mesh_ratio, separation};
 use tessera::tiling::sphere::SphereRegion;
 use tessera::{engine, Sampler};
 
@@ -54,6 +56,13 @@ fn main() -> Result<(), tessera::Error> {
             mesh_ratio(set)
         );
     }
+    // the whole set in units of the local spacing (what `tessera sphere
+    // --report` prints)
+    let local = local_spacing(&points, |p| engine::pdf(sampler.system(), &regions, p));
+    println!(
+        "refined, in units of the local spacing: separation {:.3}, covering radius {:.3}, mesh ratio {:.3}",
+        local.separation, local.covering_radius, local.mesh_ratio
+    );
     // where the close pairs are: a single cap, measured outside it and
     // beyond 10 degrees from its edge
     let cap = Regions::parse(&["cap:0,90,30,16"])?;

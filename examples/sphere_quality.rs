@@ -5,7 +5,7 @@
 //! Run: `cargo run --release --example sphere_quality`.
 
 use tessera::baselines::{jittered_healpix, spherical_fibonacci, uniform_random_sphere};
-use tessera::metrics::sphere_report;
+use tessera::metrics::{sphere_report, SphereMeasure::*};
 use tessera::Sampler;
 
 fn tessera_points(n: usize) -> Vec<glam::DVec3> {
@@ -32,11 +32,7 @@ fn main() {
             let r = sphere_report(&points);
             println!(
                 "| {n} | {name} | {:.3} | {:.3e} | {:.4} | {:.3} | {:.3} |",
-                r.separation,
-                r.cap_discrepancy_l2,
-                r.riesz1_normalized,
-                r.covering_radius,
-                r.mesh_ratio
+                r[Separation], r[CapDiscrepancy], r[Energy], r[Covering], r[MeshRatio]
             );
         }
     }
@@ -45,9 +41,9 @@ fn main() {
     for n in (1000..=3800).step_by(100) {
         let r = sphere_report(&tessera_points(n));
         let fibonacci = sphere_report(&spherical_fibonacci(n));
-        ratios.push(r.cap_discrepancy_l2 / fibonacci.cap_discrepancy_l2);
-        separation = separation.min(r.separation);
-        energy = energy.max(r.riesz1_normalized);
+        ratios.push(r[CapDiscrepancy] / fibonacci[CapDiscrepancy]);
+        separation = separation.min(r[Separation]);
+        energy = energy.max(r[Energy]);
     }
     ratios.sort_by(f64::total_cmp);
     println!();

@@ -764,3 +764,111 @@ pub fn penrose_lut() -> Arc<PenroseLut> {
     })
     .clone()
 }
+
+/// The tile systems a [`Table`] can be for.
+///
+/// # Example
+/// ```
+/// use tessera::lut::{PlaneSystem, TableSystem};
+/// assert_eq!(TableSystem::Plane(PlaneSystem::Ghexomino).name(), "ghexomino");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TableSystem {
+    /// [`SphereLut`].
+    Sphere,
+    /// [`PlaneLut`] of a polyomino.
+    Plane(PlaneSystem),
+    /// [`PenroseLut`].
+    Penrose,
+}
+
+impl TableSystem {
+    /// The system's name (its file stem in `luts/`).
+    ///
+    /// # Example
+    /// ```
+    /// assert_eq!(tessera::lut::TableSystem::Penrose.name(), "penrose");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            TableSystem::Sphere => "sphere",
+            TableSystem::Plane(system) => system.name(),
+            TableSystem::Penrose => "penrose",
+        }
+    }
+}
+
+/// A table read from a file at run time, to sample with instead of the one
+/// embedded at build time (`--table FILE`): `tessera lut build` writes
+/// them, so a rebuilt table is used without recompiling.
+///
+/// # Example
+/// ```
+/// use tessera::lut::{sphere_lut, Table, TableSystem};
+/// let path = std::env::temp_dir().join(format!("tessera-doc-table-{}.lut", std::process::id()));
+/// std::fs::write(&path, sphere_lut().to_bytes()).unwrap();
+/// let table = Table::open(&path, TableSystem::Sphere).unwrap();
+/// assert_eq!(table, Table::Sphere(sphere_lut()));
+/// let e = Table::open(&path, TableSystem::Penrose).unwrap_err().to_string();
+/// assert!(e.contains("not a penrose table"), "{e}");
+/// std::fs::remove_file(&path).unwrap();
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub enum Table {
+    /// A sphere table.
+    Sphere(Arc<SphereLut>),
+    /// A polyomino table.
+    Plane(Arc<PlaneLut>),
+    /// A Penrose table.
+    Penrose(Arc<PenroseLut>),
+}
+
+impl Table {
+    /// Reads the table of `system` from `path`, refusing (naming the file)
+    /// one that does not decode, or a polyomino table of another rep-tile.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read, [`Error::File`] when it
+    /// is not a table of `system`.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::lut::{Table, TableSystem};
+    /// let e = Table::open("no-such.lut".as_ref(), TableSystem::Sphere).unwrap_err();
+    /// assert!(e.to_string().contains("no-such.lut"));
+    /// ```
+    pub fn open(path: &std::path::Path, system: TableSystem) -> Result<Table, Error> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?;
+        let refuse = |why: String| Error::File {
+            path: path.into(),
+            reason: format!("not a {} table: {why}", system.name()),
+        };
+        let decoded = |e: Error| match e {
+            Error::Table(why) => refuse(why),
+            e => refuse(e.to_string()),
+        };
+        Ok(match system {
+            TableSystem::Sphere => {
+                Table::Sphere(Arc::new(SphereLut::from_bytes(&bytes).map_err(decoded)?))
+            }
+            TableSystem::Penrose => {
+                Table::Penrose(Arc::new(PenroseLut::from_bytes(&bytes).map_err(decoded)?))
+            }
+            TableSystem::Plane(plane) => {
+                let lut = PlaneLut::from_bytes(&bytes).map_err(decoded)?;
+                // the table carries its own rep-tile: it must be this one
+                let shipped = plane_lut(plane);
+                if lut.shape != shipped.shape || lut.arity() != shipped.arity() {
+                    return Err(refuse(format!(
+                        "its rep-tile is another ({}-rep)",
+                        lut.arity()
+                    )));
+                }
+                Table::Plane(Arc::new(lut))
+            }
+        })
+    }
+}

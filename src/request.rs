@@ -26,6 +26,8 @@ use crate::density::{Density, Uniform};
 use crate::engine::{self, Order, Sample};
 use crate::io::image::{read_raster, Raster, ReadOptions};
 use crate::lights::RgbMap;
+use crate::lut::{Table, TableSystem};
+use crate::tiling::penrose::PenroseTiling;
 use crate::tiling::plane::{PlaneRegion, PlaneTiling};
 use crate::tiling::sphere::{SphereRegion, SphereTiling};
 use crate::tiling::TileSystem;
@@ -117,7 +119,7 @@ impl SphereDensity {
 /// let request = SphereRequest { count: 500, order: Order::Unsorted, ..Default::default() };
 /// assert_eq!(request.points(&uniform).unwrap().len(), 500);
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct SphereRequest {
     /// Number of samples (exact unless `expected`).
     pub count: usize,
@@ -137,9 +139,28 @@ pub struct SphereRequest {
     /// Density-weighted Lloyd iterations run on the set
     /// ([`crate::relax::relax`]).
     pub relax: usize,
+    /// Sample with this table instead of the built-in one (a sphere
+    /// [`Table`], see [`Table::open`]).
+    pub table: Option<Table>,
 }
 
 impl SphereRequest {
+    /// The tiling driven by the request's table, or the built-in one.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{lut::{penrose_lut, Table}, request::SphereRequest};
+    /// let request = SphereRequest { table: Some(Table::Penrose(penrose_lut())), ..Default::default() };
+    /// assert!(request.tiling().unwrap_err().to_string().contains("not a sphere table"));
+    /// ```
+    pub fn tiling(&self) -> Result<SphereTiling, Error> {
+        match &self.table {
+            None => Ok(SphereTiling::default()),
+            Some(Table::Sphere(lut)) => Ok(SphereTiling::new(lut.clone())),
+            Some(_) => Err(Error::Request("the table is not a sphere table".into())),
+        }
+    }
+
     /// The request's world directions, in its order.
     ///
     /// # Example
@@ -154,7 +175,7 @@ impl SphereRequest {
     /// assert!((700..820).contains(&near.len()), "{}", near.len());
     /// ```
     pub fn points(&self, density: &SphereDensity) -> Result<Vec<DVec3>, Error> {
-        let tiling = SphereTiling::default();
+        let tiling = self.tiling()?;
         if let Some(window) = &self.within {
             let refuse = |what: &str| {
                 Err(Error::Request(format!(
@@ -230,7 +251,7 @@ impl SphereRequest {
         sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec3>) -> R,
     ) -> Result<R, Error> {
         if let SphereDensity::Regions(d) = density {
-            let tiling = SphereTiling::default();
+            let tiling = self.tiling()?;
             let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
             match engine::stream(&tiling, self.count) {
                 Some(stream) if uniform && worth_streaming(&stream) => {
@@ -538,6 +559,23 @@ pub enum PlaneKind {
     Ppentomino,
 }
 
+impl PlaneKind {
+    /// The tables this system samples with.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{lut::TableSystem, request::PlaneKind};
+    /// assert_eq!(PlaneKind::Penrose.table_system(), TableSystem::Penrose);
+    /// ```
+    pub fn table_system(self) -> TableSystem {
+        match self {
+            PlaneKind::Penrose => TableSystem::Penrose,
+            PlaneKind::Ghexomino => TableSystem::Plane(crate::lut::PlaneSystem::Ghexomino),
+            PlaneKind::Ppentomino => TableSystem::Plane(crate::lut::PlaneSystem::Ppentomino),
+        }
+    }
+}
+
 impl std::str::FromStr for PlaneKind {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
@@ -565,7 +603,7 @@ impl std::str::FromStr for PlaneKind {
 /// assert_eq!(points.len(), 400);
 /// assert!(points.iter().all(|p| p.x < 2.0 && p.y < 1.0));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct PlaneRequest {
     /// The tile system.
     pub system: PlaneKind,
@@ -580,6 +618,9 @@ pub struct PlaneRequest {
     /// Sample this rectangle instead of the unit square: the density's
     /// unit square stretched over it.
     pub domain: Option<Rectangle>,
+    /// Sample with this table of `system` instead of the built-in one (see
+    /// [`Table::open`] and [`PlaneKind::table_system`]).
+    pub table: Option<Table>,
 }
 
 impl PlaneRequest {
@@ -600,6 +641,7 @@ impl PlaneRequest {
             order: Order::Progressive,
             seed: None,
             domain: None,
+            table: None,
         }
     }
 
@@ -616,12 +658,32 @@ impl PlaneRequest {
     /// assert!(points.iter().filter(|p| p.x >= 0.5).count() > 1400);
     /// ```
     pub fn points(&self, density: &dyn Density<PlaneRegion>) -> Result<Vec<DVec2>, Error> {
-        match self.system {
-            PlaneKind::Penrose => {
-                self.points_with(&crate::tiling::penrose::PenroseTiling::default(), density)
+        match self.tiling()? {
+            Tiling::Penrose(tiling) => self.points_with(&tiling, density),
+            Tiling::Polyomino(tiling) => self.points_with(&*tiling, density),
+        }
+    }
+
+    /// The tiling of `system`, driven by the request's table or the
+    /// built-in one.
+    fn tiling(&self) -> Result<Tiling, Error> {
+        let built_in = || match self.system {
+            PlaneKind::Penrose => Tiling::Penrose(PenroseTiling::default()),
+            PlaneKind::Ghexomino => Tiling::Polyomino(Box::new(PlaneTiling::ghexomino())),
+            PlaneKind::Ppentomino => Tiling::Polyomino(Box::new(PlaneTiling::ppentomino())),
+        };
+        match (&self.table, self.system) {
+            (None, _) => Ok(built_in()),
+            (Some(Table::Penrose(lut)), PlaneKind::Penrose) => {
+                Ok(Tiling::Penrose(PenroseTiling::new(lut.clone())))
             }
-            PlaneKind::Ghexomino => self.points_with(&PlaneTiling::ghexomino(), density),
-            PlaneKind::Ppentomino => self.points_with(&PlaneTiling::ppentomino(), density),
+            (Some(Table::Plane(lut)), PlaneKind::Ghexomino | PlaneKind::Ppentomino) => {
+                Ok(Tiling::Polyomino(Box::new(PlaneTiling::new(lut.clone()))))
+            }
+            (Some(_), system) => Err(Error::Request(format!(
+                "the table is not a {} table",
+                system.table_system().name()
+            ))),
         }
     }
 
@@ -644,22 +706,7 @@ impl PlaneRequest {
     ) -> Result<R, Error> {
         let streams = density.constant().is_some() && self.domain.is_none() && self.seed.is_none();
         if streams {
-            let penrose;
-            let polyomino;
-            let tiling: &dyn StreamSource = match self.system {
-                PlaneKind::Penrose => {
-                    penrose = crate::tiling::penrose::PenroseTiling::default();
-                    &penrose
-                }
-                PlaneKind::Ghexomino => {
-                    polyomino = PlaneTiling::ghexomino();
-                    &polyomino
-                }
-                PlaneKind::Ppentomino => {
-                    polyomino = PlaneTiling::ppentomino();
-                    &polyomino
-                }
-            };
+            let tiling = self.tiling()?;
             let stream = tiling.stream(self.count);
             if let Some(mut points) = stream {
                 return Ok(sink(&mut *points));
@@ -725,15 +772,27 @@ impl PlaneRequest {
     }
 }
 
-/// A planar tiling's uniform stream, behind one type for every system.
-trait StreamSource {
-    fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>>;
+/// The tiling of a planar request, whichever system.
+enum Tiling {
+    Penrose(PenroseTiling),
+    // boxed: its level tables make it 17 times the Penrose tiling's size
+    Polyomino(Box<PlaneTiling>),
 }
 
-impl<S: TileSystem<Point = DVec2>> StreamSource for S {
+impl Tiling {
+    /// The tiling's uniform stream of `count` points, if it has one.
     fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>> {
-        let stream = engine::stream(self, count).filter(worth_streaming)?;
-        Some(Box::new(stream.map(|s| s.position)))
+        fn points<'a, S: TileSystem<Point = DVec2>>(
+            tiling: &'a S,
+            count: usize,
+        ) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + 'a>> {
+            let stream = engine::stream(tiling, count).filter(worth_streaming)?;
+            Some(Box::new(stream.map(|s| s.position)))
+        }
+        match self {
+            Tiling::Penrose(tiling) => points(tiling, count),
+            Tiling::Polyomino(tiling) => points(&**tiling, count),
+        }
     }
 }
 

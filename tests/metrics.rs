@@ -11,11 +11,14 @@ use tessera::baselines::{
 };
 use tessera::metrics::plane::{
     anisotropy, centered_l2_discrepancy, hex_spacing, l2_star_discrepancy, low_frequency_power,
-    mean_nn_distance, min_distance, periodogram, plane_report, radial_average,
+    mean_nn_distance, min_distance, periodogram, radial_average,
 };
 use tessera::metrics::sphere::{
     angular_power, cap_discrepancy_l2, covering_radius, geodesic_distance, mesh_ratio,
-    riesz1_normalized, separation, sphere_report,
+    riesz1_normalized, separation,
+};
+use tessera::metrics::{
+    plane_report, sphere_report, Measure, Options, PlaneMeasure, SphereMeasure,
 };
 
 // ---------------------------------------------------------------------------
@@ -300,8 +303,8 @@ fn empty_and_single_point() {
     assert!(mesh_ratio(&e).is_nan());
     assert_eq!(angular_power(&e, 3), vec![0.0; 4]);
     let r = sphere_report(&e);
-    assert_eq!(r.n, 0);
-    assert!(r.separation.is_nan() && r.covering_radius.is_nan());
+    assert_eq!(r.n(), 0);
+    assert!(r[SphereMeasure::Separation].is_nan() && r[SphereMeasure::Covering].is_nan());
 
     let one = [DVec3::new(0.6, 0.0, 0.8)];
     assert_eq!(separation(&one), f64::INFINITY);
@@ -315,9 +318,9 @@ fn empty_and_single_point() {
     assert!(mesh_ratio(&one).is_nan());
     assert_eq!(angular_power(&one, 3), vec![1.0; 4]);
     let r = sphere_report(&one);
-    assert_eq!(r.separation, f64::INFINITY);
-    assert_relative_eq!(r.covering_radius, PI);
-    assert!(r.mesh_ratio.is_nan());
+    assert_eq!(r[SphereMeasure::Separation], f64::INFINITY);
+    assert_relative_eq!(r[SphereMeasure::Covering], PI);
+    assert!(r[SphereMeasure::MeshRatio].is_nan());
 }
 
 #[test]
@@ -475,24 +478,33 @@ fn fibonacci_and_random_reference_values() {
         let p = spherical_fibonacci(n);
         let r = sphere_report(&p);
         eprintln!("fibonacci N = {n}: {}", serde_json::to_string(&r).unwrap());
-        assert!((r.separation - 3.09).abs() < 0.03, "{r:?}");
-        assert!((r.riesz1_normalized + 1.100).abs() < 0.005, "{r:?}");
+        assert!((r[SphereMeasure::Separation] - 3.09).abs() < 0.03, "{r:?}");
+        assert!((r[SphereMeasure::Energy] + 1.100).abs() < 0.005, "{r:?}");
         // The largest holes of the lattice sit near the poles.
-        assert!(r.covering_radius > 2.5 && r.covering_radius < 2.9, "{r:?}");
-        assert!(r.mesh_ratio > 1.6 && r.mesh_ratio < 1.9, "{r:?}");
+        assert!(
+            r[SphereMeasure::Covering] > 2.5 && r[SphereMeasure::Covering] < 2.9,
+            "{r:?}"
+        );
+        assert!(
+            r[SphereMeasure::MeshRatio] > 1.6 && r[SphereMeasure::MeshRatio] < 1.9,
+            "{r:?}"
+        );
         if n == 3072 {
-            assert!((r.cap_discrepancy_l2 - 1.09e-3).abs() < 0.03e-3, "{r:?}");
+            assert!(
+                (r[SphereMeasure::CapDiscrepancy] - 1.09e-3).abs() < 0.03e-3,
+                "{r:?}"
+            );
         }
     }
     let p = uniform_random_sphere(3072, 2024);
     let r = sphere_report(&p);
     eprintln!("random N = 3072: {}", serde_json::to_string(&r).unwrap());
     assert!(
-        r.cap_discrepancy_l2 > 5e-3 && r.cap_discrepancy_l2 < 2.5e-2,
+        r[SphereMeasure::CapDiscrepancy] > 5e-3 && r[SphereMeasure::CapDiscrepancy] < 2.5e-2,
         "{r:?}"
     );
-    assert!(r.riesz1_normalized.abs() < 0.5, "{r:?}");
-    assert!(r.separation < 0.5, "{r:?}");
+    assert!(r[SphereMeasure::Energy].abs() < 0.5, "{r:?}");
+    assert!(r[SphereMeasure::Separation] < 0.5, "{r:?}");
     // Fibonacci power is far below white noise at low l.
     let pw = angular_power(&spherical_fibonacci(3072), 30);
     assert!(pw[1..=30].iter().all(|&v| v < 0.05), "{pw:?}");
@@ -502,23 +514,64 @@ fn fibonacci_and_random_reference_values() {
 fn sphere_report_is_consistent() {
     let p = uniform_random_sphere(300, 5);
     let r = sphere_report(&p);
-    assert_eq!(r.n, 300);
-    assert_eq!(r.separation, separation(&p));
-    assert_eq!(r.cap_discrepancy_l2, cap_discrepancy_l2(&p));
-    assert_eq!(r.riesz1_normalized, riesz1_normalized(&p));
-    assert_eq!(r.covering_radius, covering_radius(&p));
-    assert_relative_eq!(r.mesh_ratio, mesh_ratio(&p), max_relative = 1e-14);
-    let json = serde_json::to_value(r).unwrap();
-    for key in [
-        "n",
-        "separation",
-        "cap_discrepancy_l2",
-        "riesz1_normalized",
-        "covering_radius",
-        "mesh_ratio",
-    ] {
-        assert!(json.get(key).is_some(), "{key}");
-    }
+    assert_eq!(r.n(), 300);
+    assert_eq!(r[SphereMeasure::Separation], separation(&p));
+    assert_eq!(r[SphereMeasure::CapDiscrepancy], cap_discrepancy_l2(&p));
+    assert_eq!(r[SphereMeasure::Energy], riesz1_normalized(&p));
+    assert_eq!(r[SphereMeasure::Covering], covering_radius(&p));
+    assert_relative_eq!(
+        r[SphereMeasure::MeshRatio],
+        mesh_ratio(&p),
+        max_relative = 1e-14
+    );
+    let json = serde_json::to_string(&r).unwrap();
+    let keys: Vec<&str> = json.split('"').skip(1).step_by(2).collect();
+    assert_eq!(
+        keys,
+        [
+            "n",
+            "separation_sqrt_n",
+            "cap_discrepancy_l2",
+            "riesz1_excess_over_n1_5",
+            "covering_radius_sqrt_n",
+            "mesh_ratio",
+        ]
+    );
+}
+
+/// `only` computes just the measures named, whatever `pairs_up_to`;
+/// without it the O(N²) ones above `pairs_up_to` are skipped (null).
+#[test]
+fn reports_compute_what_is_asked() {
+    let p = uniform_random_sphere(300, 5);
+    let all = sphere_report(&p);
+    let only = Options {
+        only: Some(vec![SphereMeasure::MeshRatio, SphereMeasure::Energy]),
+        pairs_up_to: 10,
+        ..Options::default()
+    };
+    let r = tessera::metrics::sphere::measure(&p, &only);
+    let measured: Vec<_> = r.entries().iter().map(|(m, _)| *m).collect();
+    assert_eq!(measured, [SphereMeasure::Energy, SphereMeasure::MeshRatio]);
+    assert_eq!(r[SphereMeasure::Energy], all[SphereMeasure::Energy]);
+    assert_eq!(r[SphereMeasure::MeshRatio], all[SphereMeasure::MeshRatio]);
+    let cheap = Options {
+        pairs_up_to: 10,
+        ..Options::default()
+    };
+    let r = tessera::metrics::plane::measure(&jittered_grid_2d(10, 1), &cheap);
+    assert_eq!(r.entries().len(), PlaneMeasure::ALL.len());
+    assert_eq!(
+        r.skipped().collect::<Vec<_>>(),
+        [
+            PlaneMeasure::L2Star,
+            PlaneMeasure::CenteredL2,
+            PlaneMeasure::LowFrequencyPower
+        ]
+    );
+    assert!(serde_json::to_string(&r)
+        .unwrap()
+        .ends_with("\"l2_star_discrepancy\":null,\"centered_l2_discrepancy\":null,\"low_frequency_power\":null}"));
 }
 
 proptest! {
@@ -841,28 +894,28 @@ fn plane_empty_single_and_report() {
     assert!(centered_l2_discrepancy(&e).is_nan());
     assert!(periodogram(&e, 4).iter().all(|v| v.is_nan()));
     let r = plane_report(&e);
-    assert_eq!(r.n, 0);
-    assert!(r.min_distance.is_nan());
+    assert_eq!(r.n(), 0);
+    assert!(r[PlaneMeasure::MinDistance].is_nan());
 
     let one = [DVec2::new(0.3, 0.4)];
     assert_eq!(min_distance(&one), f64::INFINITY);
     assert_eq!(mean_nn_distance(&one), f64::INFINITY);
     let r = plane_report(&one);
-    assert_eq!(r.min_distance, f64::INFINITY);
-    assert!(r.low_frequency_power.is_nan());
+    assert_eq!(r[PlaneMeasure::MinDistance], f64::INFINITY);
+    assert!(r[PlaneMeasure::LowFrequencyPower].is_nan());
 
     let p = jittered_grid_2d(20, 8);
     let r = plane_report(&p);
-    assert_eq!(r.n, 400);
-    assert_eq!(r.min_distance, min_distance(&p));
+    assert_eq!(r.n(), 400);
+    assert_eq!(r[PlaneMeasure::MinDistance], min_distance(&p));
     assert_relative_eq!(
-        r.mean_nn_distance,
+        r[PlaneMeasure::MeanNnDistance],
         mean_nn_distance(&p),
         max_relative = 1e-14
     );
-    assert_eq!(r.l2_star_discrepancy, l2_star_discrepancy(&p));
-    assert_eq!(r.centered_l2_discrepancy, centered_l2_discrepancy(&p));
-    assert_eq!(r.low_frequency_power, low_frequency_power(&p));
+    assert_eq!(r[PlaneMeasure::L2Star], l2_star_discrepancy(&p));
+    assert_eq!(r[PlaneMeasure::CenteredL2], centered_l2_discrepancy(&p));
+    assert_eq!(r[PlaneMeasure::LowFrequencyPower], low_frequency_power(&p));
     let json = serde_json::to_string(&r).unwrap();
     assert!(json.contains("\"centered_l2_discrepancy\""));
 }
@@ -946,4 +999,21 @@ fn random_baselines() {
     assert!(u
         .iter()
         .all(|q| (0.0..1.0).contains(&q.x) && (0.0..1.0).contains(&q.y)));
+}
+
+/// The plane spectrum's rings reach twice the blue-noise peak: a 50 x 50
+/// jittered grid peaks at its lattice frequency |k| = 50, inside the first
+/// half of the rings.
+#[test]
+fn plane_spectrum_reaches_twice_the_peak() {
+    let s = tessera::metrics::plane::PlaneSpectrum::new(&jittered_grid_2d(50, 3));
+    assert!(
+        s.radial_power.len() as f64 >= 2.0 * 1.07 * 50.0,
+        "{}",
+        s.size
+    );
+    let peak = (1..s.radial_power.len())
+        .max_by(|&a, &b| s.radial_power[a].total_cmp(&s.radial_power[b]))
+        .unwrap();
+    assert!((48..=52).contains(&peak), "peak at {peak}");
 }

@@ -2,7 +2,8 @@
 
 use glam::{DVec2, DVec3};
 use tessera::plot::{
-    equirectangular, line_plot, log_image, orthographic, stipple, Axes, Series, PALETTE,
+    equirectangular, line_plot, log_image, orthographic, stipple, Axes, Labels, Marker, Series,
+    PALETTE,
 };
 
 #[test]
@@ -16,13 +17,14 @@ fn stipple_places_points_y_up() {
 }
 
 #[test]
-fn equirectangular_puts_directions_at_their_longitude_and_latitude() {
+fn equirectangular_puts_directions_where_a_map_has_them() {
     let img = equirectangular(&[-DVec3::Y, -DVec3::Z], 360);
     assert_eq!(img.dimensions(), (360, 180));
-    // -y: longitude -90 degrees is a quarter of the width from the left
-    assert_eq!(img.get_pixel(90, 90)[0], 0);
-    assert_eq!(img.get_pixel(180, 179)[0], 0); // south pole, bottom row
-    assert_eq!(img.get_pixel(270, 90)[0], 255);
+    // -y: phi = atan2(-1, 0) mod 2 pi = 270 degrees, three quarters of the
+    // width from the left, as a lat-long map's column
+    assert_eq!(img.get_pixel(270, 90)[0], 0);
+    assert_eq!(img.get_pixel(0, 179)[0], 0); // south pole, bottom row, phi 0
+    assert_eq!(img.get_pixel(90, 90)[0], 255);
 }
 
 #[test]
@@ -50,10 +52,19 @@ fn line_plot_draws_each_series_and_roundtrips_through_png() {
     let rising = Series {
         points: (1..=10).map(|k| (k as f64, k as f64)).collect(),
         color: PALETTE[0],
+        name: "rising".into(),
+        marker: Marker::Square,
     };
     let falling = Series {
         points: (1..=10).map(|k| (k as f64, 1.0 / k as f64)).collect(),
         color: PALETTE[1],
+        name: "falling".into(),
+        marker: Marker::Cross,
+    };
+    let labels = Labels {
+        title: "two lines".into(),
+        x: "k".into(),
+        y: "value".into(),
     };
     let img = line_plot(
         &[rising, falling],
@@ -61,6 +72,7 @@ fn line_plot_draws_each_series_and_roundtrips_through_png() {
             log_x: true,
             log_y: true,
         },
+        &labels,
         300,
         200,
     );

@@ -232,9 +232,10 @@ fn uniform_sets_meet_the_quality_floors_against_fibonacci() {
         let ours = tessera::metrics::sphere_report(&points);
         let fibonacci =
             tessera::metrics::sphere_report(&tessera::baselines::spherical_fibonacci(n));
-        assert!(ours.separation >= 2.6, "N = {n}: {ours:?}");
-        assert!(ours.riesz1_normalized <= -1.08, "N = {n}: {ours:?}");
-        let ratio = ours.cap_discrepancy_l2 / fibonacci.cap_discrepancy_l2;
+        use tessera::metrics::SphereMeasure::*;
+        assert!(ours[Separation] >= 2.6, "N = {n}: {ours:?}");
+        assert!(ours[Energy] <= -1.08, "N = {n}: {ours:?}");
+        let ratio = ours[CapDiscrepancy] / fibonacci[CapDiscrepancy];
         assert!(
             ratio <= 1.3,
             "N = {n}: cap discrepancy {ratio:.3}x Fibonacci's"

@@ -395,6 +395,7 @@ fn sphere<'py>(
             seed,
             within: within.as_deref().map(Cap::window).transpose()?,
             relax,
+            table: None,
         };
         let points = request.points(&density)?;
         let pdfs = pdf.then(|| {
@@ -508,6 +509,7 @@ fn plane<'py>(
                 .as_deref()
                 .map(tessera::density::rectangle::Rectangle::parse)
                 .transpose()?,
+            table: None,
         };
         let points = request.points(&*density)?;
         let pdfs = pdf.then(|| {
@@ -637,64 +639,67 @@ fn from_lonlat<'py>(
     points3(py, points)
 }
 
-/// See `tessera.metrics.sphere`.
+/// See `tessera.metrics`: the measures of sphere points (an (n, 3) array
+/// of unit vectors) or plane points ((n, 2)), `only` a comma-separated
+/// list of keys.
 #[pyfunction]
-#[pyo3(signature = (points, pairs_up_to, threads))]
-fn metrics_sphere<'py>(
+#[pyo3(signature = (domain, points, only, pairs_up_to, threads))]
+fn metrics<'py>(
     py: Python<'py>,
+    domain: &str,
     points: PyReadonlyArray2<'py, f64>,
+    only: Option<String>,
     pairs_up_to: usize,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let points: Vec<DVec3> = rows::<3>(&points)?
-        .into_iter()
-        .map(DVec3::from_array)
-        .collect();
-    if points.is_empty() {
-        return Err(PyValueError::new_err("points: there are no points"));
+    use tessera::metrics::{plane, sphere};
+    let options = (only, pairs_up_to, threads);
+    if domain == "sphere" {
+        let points: Vec<DVec3> = rows::<3>(&points)?
+            .into_iter()
+            .map(DVec3::from_array)
+            .collect();
+        let bad = sphere::first_non_unit(&points)
+            .map(|k| format!("point {k} ({}) is not a unit vector", points[k]));
+        measured(py, points, bad, options, sphere::measure)
+    } else {
+        let points: Vec<DVec2> = rows::<2>(&points)?
+            .into_iter()
+            .map(DVec2::from_array)
+            .collect();
+        let bad = (points.iter().position(|p| !p.is_finite()))
+            .map(|k| format!("point {k} ({}) is not finite", points[k]));
+        measured(py, points, bad, options, plane::measure)
     }
-    if let Some(k) = tessera::metrics::sphere::first_non_unit(&points) {
-        return Err(PyValueError::new_err(format!(
-            "points: point {k} ({}) is not a unit vector",
-            points[k]
-        )));
-    }
-    let report = run(py, threads, move || {
-        Ok(tessera::metrics::sphere::sphere_report_up_to(
-            &points,
-            pairs_up_to,
-        ))
-    })?;
-    Ok(pythonize::pythonize(py, &report)?)
 }
 
-/// See `tessera.metrics.plane`.
-#[pyfunction]
-#[pyo3(signature = (points, pairs_up_to, threads))]
-fn metrics_plane<'py>(
+/// The report of `measure` on `points` as a dict, unless they are empty or
+/// `bad` says what is wrong with them; `options` are `only`,
+/// `pairs_up_to` and `threads`.
+fn measured<'py, P: Send + Sync, M: tessera::metrics::Measure>(
     py: Python<'py>,
-    points: PyReadonlyArray2<'py, f64>,
-    pairs_up_to: usize,
-    threads: Option<usize>,
+    points: Vec<P>,
+    bad: Option<String>,
+    (only, pairs_up_to, threads): (Option<String>, usize, Option<usize>),
+    measure: fn(&[P], &tessera::metrics::Options<M>) -> tessera::metrics::Report<M>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let points: Vec<DVec2> = rows::<2>(&points)?
-        .into_iter()
-        .map(DVec2::from_array)
-        .collect();
     if points.is_empty() {
         return Err(PyValueError::new_err("points: there are no points"));
     }
-    if let Some(k) = points.iter().position(|p| !p.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "points: point {k} ({}) is not finite",
-            points[k]
-        )));
+    if let Some(why) = bad {
+        return Err(PyValueError::new_err(format!("points: {why}")));
     }
     let report = run(py, threads, move || {
-        Ok(tessera::metrics::plane::plane_report_up_to(
-            &points,
+        let only = only
+            .as_deref()
+            .map(tessera::metrics::parse_measures)
+            .transpose()?;
+        let options = tessera::metrics::Options {
+            only,
             pairs_up_to,
-        ))
+            ..Default::default()
+        };
+        Ok(measure(&points, &options))
     })?;
     Ok(pythonize::pythonize(py, &report)?)
 }
@@ -807,11 +812,11 @@ fn _tessera(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lights, m)?)?;
     m.add_function(wrap_pyfunction!(lonlat, m)?)?;
     m.add_function(wrap_pyfunction!(from_lonlat, m)?)?;
-    m.add_function(wrap_pyfunction!(metrics_sphere, m)?)?;
-    m.add_function(wrap_pyfunction!(metrics_plane, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics, m)?)?;
     m.add_function(wrap_pyfunction!(open_map, m)?)?;
     m.add_class::<Stream>()?;
     m.add_class::<Map>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("PAIRS_UP_TO", tessera::metrics::PAIRS_UP_TO)?;
     Ok(())
 }

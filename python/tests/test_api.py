@@ -183,6 +183,7 @@ def test_bad_requests_raise_value_error_with_the_library_message(tmp_path):
         (lambda: tessera.pdf(np.ones((2, 2))), "(n, 3)"),
         (lambda: tessera.metrics.sphere(np.ones((5, 3))), "not a unit vector"),
         (lambda: tessera.metrics.plane(np.zeros((0, 2))), "no points"),
+        (lambda: tessera.metrics.plane(np.zeros((5, 2)), only="separation_sqrt_n"), "unknown measure 'separation_sqrt_n'"),
         (lambda: tessera.stream(10, chunk=0), "chunk must be at least 1"),
         (lambda: tessera.sphere(10, map=tessera.Map(np.ones((4, 8))), up="y"), "give them to Map()"),
         (lambda: tessera.Map(np.zeros((4, 8))), "nothing to sample"),

@@ -216,14 +216,14 @@ def test_metrics_are_the_cli_metrics(cli, tmp_path):
     points_file.write_bytes(cli("sphere", "-n", 1500, "--density", "cap:0,0,30,4", "--format", "bin"))
     expected = json.loads(cli("metrics", "sphere", points_file, "--json"))
     report = tessera.metrics.sphere(read_utk(points_file.read_bytes()))
-    # the same keys (the CLI prints them sorted) and values, exactly
-    assert sorted(report) == sorted(expected)
+    # the same keys in the same order, and the same values, exactly
+    assert list(report) == list(expected)
     assert report == expected
     plane_file = tmp_path / "plane.bin"
     plane_file.write_bytes(cli("plane", "--system", "penrose", "-n", 1200, "--density", "ramp", "--format", "bin"))
     expected = json.loads(cli("metrics", "plane", plane_file, "--json"))
     report = tessera.metrics.plane(tessera.plane(1200, "penrose", "ramp"))
-    assert sorted(report) == sorted(expected)
+    assert list(report) == list(expected)
     assert report == expected
     # beyond --pairs-up-to the O(N^2) measures are null there, NaN here
     for domain, path, measure in [("sphere", points_file, tessera.metrics.sphere), ("plane", plane_file, tessera.metrics.plane)]:
@@ -233,3 +233,9 @@ def test_metrics_are_the_cli_metrics(cli, tmp_path):
         skipped = [k for k, v in expected.items() if v is None]
         assert skipped and all(np.isnan(report[k]) for k in skipped)
         assert {k: v for k, v in report.items() if k not in skipped} == {k: v for k, v in expected.items() if k not in skipped}
+    # --only / only=: just those keys, computed whatever N
+    only = ["low_frequency_power", "min_distance_over_hex_spacing"]
+    expected = json.loads(cli("metrics", "plane", plane_file, "--json", "--pairs-up-to", 10, "--only", ",".join(only)))
+    report = tessera.metrics.plane(read_utk(plane_file.read_bytes()).reshape(-1, 2), only=only, pairs_up_to=10)
+    assert list(report) == list(expected) == ["n", "min_distance_over_hex_spacing", "low_frequency_power"]
+    assert report == expected

@@ -1,7 +1,7 @@
 //! `ACCURACY.md` and its plots from [`Results`].
 
 use super::{Results, Row};
-use crate::plot::{line_plot, Axes, Series, PALETTE, PALETTE_NAMES};
+use crate::plot::{line_plot, Axes, Labels, Marker, Series, PALETTE, PALETTE_NAMES};
 use crate::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -18,6 +18,29 @@ fn distinct<'r>(rows: impl Iterator<Item = &'r Row>, key: impl Fn(&Row) -> &str)
         }
     }
     out
+}
+
+/// A method's sampler and knob: `"ghexomino f32"` is `("ghexomino",
+/// "f32")`, a method without a knob has `""`.
+fn sampler_and_knob(method: &str) -> (&str, &str) {
+    match method.rsplit_once(' ') {
+        Some((sampler, knob)) if KNOBS.contains(&knob) => (sampler, knob),
+        _ => (method, ""),
+    }
+}
+
+/// The tile samplers' settings besides the default, each with its marker.
+const KNOBS: [&str; 4] = ["f32", "no-offsets", "fixed", "expected-N"];
+
+/// The marker of a knob: squares for the default setting.
+fn marker(knob: &str) -> Marker {
+    match knob {
+        "" => Marker::Square,
+        "f32" => Marker::Hollow,
+        "no-offsets" => Marker::Cross,
+        "fixed" => Marker::Plus,
+        _ => Marker::Diamond,
+    }
 }
 
 fn scientific(v: f64) -> String {
@@ -82,6 +105,14 @@ impl Results {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let mut md = self.preamble(command);
         let mut files = Vec::new();
+        // one colour per sampler over every plot of the report, in the
+        // order samplers first appear; knobs differ by marker
+        let samplers = distinct(self.rows.iter(), |r| sampler_and_knob(&r.method).0);
+        let colour = |method: &str| {
+            let sampler = sampler_and_knob(method).0;
+            let k = samplers.iter().position(|s| s == sampler).unwrap_or(0);
+            (PALETTE[k % PALETTE.len()], PALETTE_NAMES[k % PALETTE.len()])
+        };
         for scenario in distinct(self.rows.iter(), |r| &r.scenario) {
             let rows: Vec<&Row> = self
                 .rows
@@ -90,7 +121,7 @@ impl Results {
                 .collect();
             let methods = distinct(rows.iter().copied(), |r| &r.method);
             let integrands = distinct(rows.iter().copied(), |r| &r.integrand);
-            self.section(&mut md, &scenario, &rows, &methods, &integrands);
+            self.section(&mut md, &scenario, &rows, &methods, &integrands, &colour);
             for integrand in &integrands {
                 let on: Vec<&Row> = rows
                     .iter()
@@ -103,10 +134,11 @@ impl Results {
                 ] {
                     let series: Vec<Series> = methods
                         .iter()
-                        .enumerate()
-                        .map(|(k, m)| Series {
+                        .map(|m| Series {
                             points: curve(&on, m, x),
-                            color: PALETTE[k % PALETTE.len()],
+                            color: colour(m).0,
+                            name: m.clone(),
+                            marker: marker(sampler_and_knob(m).1),
                         })
                         .collect();
                     let name = format!("accuracy-{scenario}-{integrand}-{suffix}.png");
@@ -115,7 +147,17 @@ impl Results {
                         log_x: true,
                         log_y: true,
                     };
-                    line_plot(&series, axes, 640, 420)
+                    let labels = Labels {
+                        title: format!("{scenario}: {integrand}"),
+                        x: if suffix == "n" {
+                            "N (samples)"
+                        } else {
+                            "seconds to draw"
+                        }
+                        .into(),
+                        y: "relative RMSE".into(),
+                    };
+                    line_plot(&series, axes, &labels, 840, 440)
                         .save_with_format(&path, image::ImageFormat::Png)
                         .map_err(|e| Error::File {
                             path: path.clone(),
@@ -245,6 +287,7 @@ impl Results {
         rows: &[&Row],
         methods: &[String],
         integrands: &[String],
+        colour: &dyn Fn(&str) -> ([u8; 3], &'static str),
     ) {
         let n_max = rows.iter().map(|r| r.n).max().unwrap_or(0);
         let head = |first: &str| {
@@ -321,13 +364,16 @@ impl Results {
         }
         let legend: Vec<String> = methods
             .iter()
-            .enumerate()
-            .map(|(k, m)| format!("{m}: {}", PALETTE_NAMES[k % PALETTE.len()]))
+            .map(|m| {
+                let (sampler, knob) = sampler_and_knob(m);
+                let mark = format!("{:?}", marker(knob)).to_lowercase();
+                format!("{m}: {} {mark}", colour(sampler).1)
+            })
             .collect();
         let _ = writeln!(
             md,
-            "\nPlots (log-log; relative RMSE against N, then against seconds to draw). \
-             Colours: {}.\n",
+            "\nPlots (log-log; relative RMSE against N, then against seconds to draw; \
+             one colour per sampler in every plot, one marker per setting): {}.\n",
             legend.join(", ")
         );
     }

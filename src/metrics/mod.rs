@@ -9,23 +9,30 @@
 //!   Hickernell's centred L2 discrepancy, periodogram with radial average and
 //!   anisotropy, and the low-frequency power of points in `[0, 1)²`.
 //!
+//! * [`report`]: the measures by key ([`SphereMeasure`], [`PlaneMeasure`]),
+//!   which of them to compute ([`Options`]) and the [`Report`] of their
+//!   values that `tessera metrics` prints.
+//!
 //! The O(N²) sums are parallel (rayon) and accumulated in double-double
 //! arithmetic, so that the small differences they feed (D² = 1/3 − …) keep
 //! their precision; see each function for the precision actually obtained.
 //!
 //! ```
 //! use tessera::baselines::spherical_fibonacci;
-//! use tessera::metrics::sphere_report;
+//! use tessera::metrics::{sphere_report, SphereMeasure};
 //! let report = sphere_report(&spherical_fibonacci(256));
-//! assert!(report.separation > 2.9 && report.separation < 3.3);
+//! let separation = report[SphereMeasure::Separation];
+//! assert!(separation > 2.9 && separation < 3.3);
 //! ```
 
 pub mod irradiance;
 pub mod plane;
+pub mod report;
 pub mod sphere;
 
-pub use plane::{plane_report, PlaneReport};
-pub use sphere::{sphere_report, SphereReport};
+pub use plane::{plane_report, PlaneMeasure};
+pub use report::{parse_measures, Measure, Options, Progress, Report, PAIRS_UP_TO};
+pub use sphere::{sphere_report, SphereMeasure};
 
 /// Double-double number `hi + lo` (about 106 bits), used to accumulate the
 /// O(N²) pair sums without loss (Ogita–Rump–Oishi cascaded summation).

@@ -20,6 +20,7 @@
 //! assert!(low_frequency_power(&jit) < low_frequency_power(&rnd));
 //! ```
 
+use super::report::{quiet, Measure, Options, Progress, Report, Tally};
 use super::Dd;
 use glam::DVec2;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -43,9 +44,10 @@ pub fn hex_spacing(n: usize) -> f64 {
 }
 
 /// Euclidean distance from each point to its nearest other point (N ≥ 2).
-fn nn_distances(points: &[DVec2]) -> Vec<f64> {
+fn nn_distances(points: &[DVec2], progress: Progress) -> Vec<f64> {
     let coords: Vec<[f64; 2]> = points.iter().map(|p| p.to_array()).collect();
     let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&coords);
+    let tally = Tally::new("neighbours", points.len() as u64, progress);
     (0..points.len())
         .into_par_iter()
         .map(|i| {
@@ -55,6 +57,7 @@ fn nn_distances(points: &[DVec2]) -> Vec<f64> {
                 .map(|nn| nn.item as usize)
                 .find(|&j| j != i)
                 .expect("a tree of at least two points returns another point");
+            tally.add(1);
             points[i].distance(points[j])
         })
         .collect()
@@ -76,7 +79,7 @@ pub fn min_distance(points: &[DVec2]) -> f64 {
         0 => f64::NAN,
         1 => f64::INFINITY,
         n => {
-            nn_distances(points)
+            nn_distances(points, &quiet)
                 .into_iter()
                 .fold(f64::INFINITY, f64::min)
                 / hex_spacing(n)
@@ -101,18 +104,27 @@ pub fn mean_nn_distance(points: &[DVec2]) -> f64 {
         1 => f64::INFINITY,
         n => {
             let mut acc = Dd::ZERO;
-            nn_distances(points).into_iter().for_each(|d| acc.add(d));
+            nn_distances(points, &quiet)
+                .into_iter()
+                .for_each(|d| acc.add(d));
             acc.value() / n as f64 / hex_spacing(n)
         }
     }
 }
 
+/// Number of unordered pairs of `n` points.
+fn pairs(n: usize) -> u64 {
+    (n as u64) * (n as u64).saturating_sub(1) / 2
+}
+
 /// `Σ_i single(x_i)` and `Σ_{i,j} pair(x_i, x_j)` (ordered pairs, symmetric
-/// `pair`), in double-double, parallel over rows.
+/// `pair`), in double-double, parallel over rows; each row's pairs are
+/// added to `tally`.
 fn single_and_pair_sums(
     points: &[DVec2],
     single: impl Fn(DVec2) -> f64 + Sync,
     pair: impl Fn(DVec2, DVec2) -> f64 + Sync,
+    tally: &Tally,
 ) -> (Dd, Dd) {
     (0..points.len())
         .into_par_iter()
@@ -126,6 +138,7 @@ fn single_and_pair_sums(
             }
             let mut d = off.plus(off);
             d.add(pair(p, p));
+            tally.add((points.len() - 1 - i) as u64);
             (s, d)
         })
         .reduce(
@@ -166,6 +179,10 @@ fn combine(constant: Dd, a: f64, single_sum: Dd, pair_sum: Dd, n: usize) -> f64 
 /// assert!((t * t - 23.0 / 288.0).abs() < 1e-15);
 /// ```
 pub fn l2_star_discrepancy(points: &[DVec2]) -> f64 {
+    l2_star(points, &Tally::new("pairs", pairs(points.len()), &quiet))
+}
+
+fn l2_star(points: &[DVec2], tally: &Tally) -> f64 {
     let n = points.len();
     if n == 0 {
         return f64::NAN;
@@ -174,6 +191,7 @@ pub fn l2_star_discrepancy(points: &[DVec2]) -> f64 {
         points,
         |p| (1.0 - p.x * p.x) * (1.0 - p.y * p.y),
         |p, q| (1.0 - p.x.max(q.x)) * (1.0 - p.y.max(q.y)),
+        tally,
     );
     combine(Dd::ratio(1.0, 9.0), -0.5, s, p, n)
 }
@@ -196,6 +214,10 @@ pub fn l2_star_discrepancy(points: &[DVec2]) -> f64 {
 /// assert!((cd - 5.0 / 12.0).abs() < 1e-15);
 /// ```
 pub fn centered_l2_discrepancy(points: &[DVec2]) -> f64 {
+    centered_l2(points, &Tally::new("pairs", pairs(points.len()), &quiet))
+}
+
+fn centered_l2(points: &[DVec2], tally: &Tally) -> f64 {
     let n = points.len();
     if n == 0 {
         return f64::NAN;
@@ -210,6 +232,7 @@ pub fn centered_l2_discrepancy(points: &[DVec2]) -> f64 {
         points,
         |p| f1(p.x) * f1(p.y),
         |p, q| f2(p.x, q.x) * f2(p.y, q.y),
+        tally,
     );
     combine(Dd::ratio(169.0, 144.0), -2.0, s, p, n)
 }
@@ -244,6 +267,15 @@ fn k_min(size: usize) -> i64 {
 /// assert!(p.iter().all(|v| (v - 1.0).abs() < 1e-12));
 /// ```
 pub fn periodogram(points: &[DVec2], size: usize) -> Vec<f64> {
+    periodogram_with(
+        points,
+        size,
+        &Tally::new("periodogram", points.len() as u64, &quiet),
+    )
+}
+
+/// [`periodogram`], adding each chunk of points to `tally`.
+fn periodogram_with(points: &[DVec2], size: usize, tally: &Tally) -> Vec<f64> {
     let n = points.len();
     if n == 0 {
         return vec![f64::NAN; size * size];
@@ -289,6 +321,7 @@ pub fn periodogram(points: &[DVec2], size: usize) -> Vec<f64> {
                     }
                 }
             });
+        tally.add(m as u64);
     }
     let nf = n as f64;
     let mut out = vec![0.0f64; size * size];
@@ -461,6 +494,10 @@ pub fn anisotropy(periodogram: &[f64], size: usize) -> Vec<f64> {
 /// assert!(w > 0.85 && w < 1.15);
 /// ```
 pub fn low_frequency_power(points: &[DVec2]) -> f64 {
+    low_frequency(points, &quiet)
+}
+
+fn low_frequency(points: &[DVec2], progress: Progress) -> f64 {
     let n = points.len();
     let r2 = n as f64 / 4.0; // |k|² < (√N / 2)²
     let kmax = r2.sqrt().ceil() as usize;
@@ -468,7 +505,8 @@ pub fn low_frequency_power(points: &[DVec2]) -> f64 {
     if n <= 4 {
         return f64::NAN;
     }
-    let p = periodogram(points, size);
+    let tally = Tally::new("low frequencies", n as u64, progress);
+    let p = periodogram_with(points, size, &tally);
     let k0 = k_min(size);
     let mut sum = Dd::ZERO;
     let mut count = 0usize;
@@ -488,91 +526,162 @@ pub fn low_frequency_power(points: &[DVec2]) -> f64 {
     }
 }
 
-/// Summary of the plane metrics of one point set (serialisable).
+/// The measures of [`measure`], by their keys in reports.
 ///
 /// ```
-/// use tessera::baselines::jittered_grid_2d;
-/// use tessera::metrics::plane::plane_report;
-/// let r = plane_report(&jittered_grid_2d(10, 1));
-/// assert_eq!(r.n, 100);
-/// println!("{}", serde_json::to_string(&r).unwrap());
+/// use tessera::metrics::{Measure, PlaneMeasure};
+/// assert!(PlaneMeasure::L2Star.quadratic() && !PlaneMeasure::MinDistance.quadratic());
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct PlaneReport {
-    /// Number of points.
-    pub n: usize,
-    /// [`min_distance`]: minimum distance / hexagonal spacing.
-    pub min_distance: f64,
-    /// [`mean_nn_distance`]: mean nearest-neighbour distance / hexagonal spacing.
-    pub mean_nn_distance: f64,
-    /// [`l2_star_discrepancy`]: Warnock's L2-star discrepancy.
-    pub l2_star_discrepancy: f64,
-    /// [`centered_l2_discrepancy`]: Hickernell's centred L2 discrepancy.
-    pub centered_l2_discrepancy: f64,
-    /// [`low_frequency_power`]: mean power for 0 < |k| < √N / 2.
-    pub low_frequency_power: f64,
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PlaneMeasure {
+    /// [`min_distance`].
+    MinDistance,
+    /// [`mean_nn_distance`].
+    MeanNnDistance,
+    /// [`l2_star_discrepancy`].
+    L2Star,
+    /// [`centered_l2_discrepancy`].
+    CenteredL2,
+    /// [`low_frequency_power`].
+    LowFrequencyPower,
 }
 
-/// Computes every field of [`PlaneReport`]; cost dominated by the three
-/// O(N²) terms.
-///
-/// ```
-/// use tessera::baselines::uniform_random_2d;
-/// use tessera::metrics::plane_report;
-/// let r = plane_report(&uniform_random_2d(256, 5));
-/// assert!(r.l2_star_discrepancy > 0.0 && r.l2_star_discrepancy < 0.1);
-/// ```
-pub fn plane_report(points: &[DVec2]) -> PlaneReport {
-    plane_report_up_to(points, usize::MAX)
-}
+impl Measure for PlaneMeasure {
+    const ALL: &'static [Self] = &[
+        PlaneMeasure::MinDistance,
+        PlaneMeasure::MeanNnDistance,
+        PlaneMeasure::L2Star,
+        PlaneMeasure::CenteredL2,
+        PlaneMeasure::LowFrequencyPower,
+    ];
 
-/// [`plane_report`] with the three O(N²) measures (both discrepancies and
-/// the low-frequency power) only up to `pair_limit` points: NaN (JSON
-/// `null`) beyond it, so that large sets cost O(N log N).
-///
-/// ```
-/// use tessera::baselines::uniform_random_2d;
-/// use tessera::metrics::plane::plane_report_up_to;
-/// let r = plane_report_up_to(&uniform_random_2d(256, 5), 100);
-/// assert!(r.l2_star_discrepancy.is_nan() && r.min_distance > 0.0);
-/// ```
-pub fn plane_report_up_to(points: &[DVec2], pair_limit: usize) -> PlaneReport {
-    let pairs = points.len() <= pair_limit;
-    let distances = (points.len() >= 2).then(|| nn_distances(points));
-    let (min_distance, mean_nn_distance) = match (&distances, points.len()) {
-        (_, 0) => (f64::NAN, f64::NAN),
-        (None, _) => (f64::INFINITY, f64::INFINITY),
-        (Some(d), n) => {
-            let mut acc = Dd::ZERO;
-            d.iter().for_each(|&v| acc.add(v));
-            let h = hex_spacing(n);
-            (
-                d.iter().copied().fold(f64::INFINITY, f64::min) / h,
-                acc.value() / n as f64 / h,
-            )
+    fn key(self) -> &'static str {
+        match self {
+            PlaneMeasure::MinDistance => "min_distance_over_hex_spacing",
+            PlaneMeasure::MeanNnDistance => "mean_nn_distance_over_hex_spacing",
+            PlaneMeasure::L2Star => "l2_star_discrepancy",
+            PlaneMeasure::CenteredL2 => "centered_l2_discrepancy",
+            PlaneMeasure::LowFrequencyPower => "low_frequency_power",
         }
-    };
-    PlaneReport {
-        n: points.len(),
-        min_distance,
-        mean_nn_distance,
-        l2_star_discrepancy: if pairs {
-            l2_star_discrepancy(points)
-        } else {
-            f64::NAN
-        },
-        centered_l2_discrepancy: if pairs {
-            centered_l2_discrepancy(points)
-        } else {
-            f64::NAN
-        },
-        low_frequency_power: if pairs {
-            low_frequency_power(points)
-        } else {
-            f64::NAN
-        },
+    }
+
+    fn meaning(self) -> &'static str {
+        match self {
+            PlaneMeasure::MinDistance => {
+                "The smallest distance between two points over the spacing \
+                 sqrt(2 / (sqrt(3) N)) of the hexagonal lattice with N points per unit \
+                 area (Euclidean, no wrap-around). Higher is better: 1 for that \
+                 lattice, near 0 for independent uniform points. Cost O(N log N)."
+            }
+            PlaneMeasure::MeanNnDistance => {
+                "The mean distance from a point to its nearest other point, over the \
+                 same hexagonal spacing: 1 for that lattice, about 0.465 for \
+                 independent uniform points (1 / (2 sqrt(N)) away from the border). \
+                 Cost O(N log N)."
+            }
+            PlaneMeasure::L2Star => {
+                "Warnock's L2-star discrepancy T of [0,1)^2, not normalised: the L2 \
+                 norm of the local discrepancy over anchored boxes [0,u) x [0,v) \
+                 (closed form). Lower is better. Cost O(N^2)."
+            }
+            PlaneMeasure::CenteredL2 => {
+                "Hickernell's centred L2 discrepancy CD, not normalised: boxes between \
+                 a point and its nearest corner of the square, 1-D projections \
+                 included (closed form). Lower is better. Cost O(N^2)."
+            }
+            PlaneMeasure::LowFrequencyPower => {
+                "The mean periodogram power |sum_j exp(-2 pi i k.x_j)|^2 / N over the \
+                 integer frequencies 0 < |k| < sqrt(N) / 2: 1 in expectation for \
+                 independent uniform points (white noise), lower for blue noise, 0 \
+                 for a sqrt(N) x sqrt(N) square lattice. Cost O(N^2)."
+            }
+        }
+    }
+
+    fn quadratic(self) -> bool {
+        !matches!(
+            self,
+            PlaneMeasure::MinDistance | PlaneMeasure::MeanNnDistance
+        )
     }
 }
+
+/// The measures `options` ask for (all by default, the O(N²) ones only up
+/// to [`Options::pairs_up_to`] points), the two distance measures from one
+/// k-d tree pass. Values equal those of the functions named in
+/// [`PlaneMeasure`] (up to rounding for the mean distance).
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::{plane, Options, PlaneMeasure};
+/// let points = uniform_random_2d(256, 5);
+/// let options = Options { only: Some(vec![PlaneMeasure::L2Star]), ..Options::default() };
+/// let r = plane::measure(&points, &options);
+/// assert_eq!(r.entries().len(), 1);
+/// assert_eq!(r[PlaneMeasure::L2Star], plane::l2_star_discrepancy(&points));
+/// ```
+pub fn measure(points: &[DVec2], options: &Options<PlaneMeasure>) -> Report<PlaneMeasure> {
+    use PlaneMeasure::*;
+    let n = points.len();
+    let distances = (n >= 2
+        && (options.computes(MinDistance, n) || options.computes(MeanNnDistance, n)))
+    .then(|| nn_distances(points, options.progress));
+    let distance = |mean: bool| match (&distances, n) {
+        (_, 0) => f64::NAN,
+        (_, 1) => f64::INFINITY,
+        (None, _) => unreachable!("distances are computed when asked for"),
+        (Some(d), n) if mean => {
+            let mut acc = Dd::ZERO;
+            d.iter().for_each(|&v| acc.add(v));
+            acc.value() / n as f64 / hex_spacing(n)
+        }
+        (Some(d), n) => d.iter().copied().fold(f64::INFINITY, f64::min) / hex_spacing(n),
+    };
+    let discrepancies = |centred| {
+        let tally = Tally::new(
+            if centred { "centred pairs" } else { "pairs" },
+            pairs(n),
+            options.progress,
+        );
+        if centred {
+            centered_l2(points, &tally)
+        } else {
+            l2_star(points, &tally)
+        }
+    };
+    Report::new(n, options, |m| match m {
+        MinDistance => distance(false),
+        MeanNnDistance => distance(true),
+        L2Star => discrepancies(false),
+        CenteredL2 => discrepancies(true),
+        LowFrequencyPower => low_frequency(points, options.progress),
+    })
+}
+
+/// Every measure of [`PlaneMeasure`], whatever N.
+///
+/// ```
+/// use tessera::baselines::uniform_random_2d;
+/// use tessera::metrics::{plane_report, PlaneMeasure};
+/// let r = plane_report(&uniform_random_2d(256, 5));
+/// assert!(r[PlaneMeasure::L2Star] > 0.0 && r[PlaneMeasure::L2Star] < 0.1);
+/// ```
+pub fn plane_report(points: &[DVec2]) -> Report<PlaneMeasure> {
+    let options = Options {
+        pairs_up_to: usize::MAX,
+        ..Options::default()
+    };
+    measure(points, &options)
+}
+
+/// Above this many points, [`PlaneSpectrum`] measures a corner window
+/// holding about this many (its grid then reaches twice the blue-noise
+/// peak at a bounded cost, O(N · size²) with size ≈ 4.4 √N).
+///
+/// ```
+/// assert_eq!(tessera::metrics::plane::SPECTRUM_POINTS, 20_000);
+/// ```
+pub const SPECTRUM_POINTS: usize = 20_000;
 
 /// The periodogram of a point set on a grid sized to it, with its radial
 /// average and anisotropy (what `tessera metrics plane --spectrum` prints).
@@ -582,39 +691,77 @@ pub fn plane_report_up_to(points: &[DVec2], pair_limit: usize) -> PlaneReport {
 /// use tessera::metrics::plane::PlaneSpectrum;
 /// let s = PlaneSpectrum::new(&uniform_random_2d(256, 1));
 /// assert_eq!(s.periodogram.len(), s.size * s.size);
-/// assert_eq!(s.radial_average.len(), s.size / 2);
+/// assert_eq!(s.radial_power.len(), s.size / 2);
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PlaneSpectrum {
-    /// Side of the frequency grid.
+    /// Side of the frequency grid: frequencies `|kx|, |ky| ≤ size / 2`.
     pub size: usize,
+    /// Side of the square `[0, window)²` measured, rescaled to the unit
+    /// square: 1 up to [`SPECTRUM_POINTS`] points, then the corner holding
+    /// about that many (frequencies are then in the window's units).
+    pub window: f64,
+    /// Number of points measured (those in the window).
+    pub points: usize,
     /// [`periodogram`] on the grid.
     pub periodogram: Vec<f64>,
-    /// [`radial_average`] of it.
-    pub radial_average: Vec<f64>,
-    /// [`anisotropy`] of it, in dB.
-    pub anisotropy: Vec<f64>,
+    /// [`radial_average`] of it: the mean power of each ring of integer
+    /// radius (white noise 1).
+    pub radial_power: Vec<f64>,
+    /// [`anisotropy`] of each ring, in dB (isotropic noise about 0).
+    pub anisotropy_db: Vec<f64>,
 }
 
 impl PlaneSpectrum {
-    /// The spectrum on a grid of side `4√N` rounded up to a power of two,
-    /// between 32 and 256 (twice the blue-noise peak's radius `√N/2`...`√N`
-    /// fits); cost O(N · size²).
+    /// The spectrum on a grid of side `2 ⌈2.2 √N⌉` (at least 32), so that
+    /// its rings reach twice the blue-noise peak (near `|k| = 1.07 √N`, the
+    /// first ring of the hexagonal lattice of N points); above
+    /// [`SPECTRUM_POINTS`] points, of the corner window holding about that
+    /// many. Cost O(N · size²).
     ///
     /// ```
     /// use tessera::baselines::jittered_grid_2d;
     /// use tessera::metrics::plane::PlaneSpectrum;
-    /// assert_eq!(PlaneSpectrum::new(&jittered_grid_2d(16, 1)).size, 64);
+    /// let s = PlaneSpectrum::new(&jittered_grid_2d(16, 1));
+    /// assert_eq!((s.size, s.window, s.points), (72, 1.0, 256));
     /// ```
     pub fn new(points: &[DVec2]) -> Self {
-        let size = ((4.0 * (points.len() as f64).sqrt()).ceil() as usize)
-            .next_power_of_two()
-            .clamp(32, 256);
-        let periodogram = periodogram(points, size);
+        Self::with_progress(points, &quiet)
+    }
+
+    /// [`PlaneSpectrum::new`], telling `progress` how many points are
+    /// transformed (stage `"spectrum"`).
+    ///
+    /// ```
+    /// use tessera::baselines::jittered_grid_2d;
+    /// use tessera::metrics::plane::PlaneSpectrum;
+    /// let told = std::sync::atomic::AtomicBool::new(false);
+    /// let s = PlaneSpectrum::with_progress(&jittered_grid_2d(16, 1), &|stage, _, _| {
+    ///     told.store(stage == "spectrum", std::sync::atomic::Ordering::Relaxed);
+    /// });
+    /// assert!(told.into_inner() && s.size == 72);
+    /// ```
+    pub fn with_progress(points: &[DVec2], progress: Progress) -> Self {
+        let n = points.len();
+        let window = if n > SPECTRUM_POINTS {
+            (SPECTRUM_POINTS as f64 / n as f64).sqrt()
+        } else {
+            1.0
+        };
+        let kept: Vec<DVec2> = points
+            .iter()
+            .filter(|p| window == 1.0 || (p.x < window && p.y < window))
+            .map(|p| *p / window)
+            .collect();
+        let size = (2 * (2.2 * (kept.len() as f64).sqrt()).ceil() as usize).max(32);
+        let tally = Tally::new("spectrum", kept.len() as u64, progress);
+        let periodogram = periodogram_with(&kept, size, &tally);
         PlaneSpectrum {
             size,
-            radial_average: radial_average(&periodogram, size),
-            anisotropy: anisotropy(&periodogram, size),
+            window,
+            points: kept.len(),
+            radial_power: radial_average(&periodogram, size),
+            anisotropy_db: anisotropy(&periodogram, size),
             periodogram,
         }
     }

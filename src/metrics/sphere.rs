@@ -22,8 +22,9 @@
 //! assert!(cap_discrepancy_l2(&fib) < 0.2 * cap_discrepancy_l2(&rnd));
 //! ```
 
+use super::report::{quiet, Measure, Options, Progress, Report, Tally};
 use super::Dd;
-use crate::voronoi::{build_tree, cell_of, Tree3};
+use crate::voronoi::{build_tree, cell_of, spatial_order, Tree3};
 use glam::DVec3;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
@@ -71,18 +72,6 @@ fn nearest_other(tree: &Tree3, points: &[DVec3], i: usize) -> usize {
         .expect("a tree of at least two points returns another point")
 }
 
-/// Minimum geodesic distance over all pairs (unnormalised); +∞ for N < 2.
-fn min_geodesic(points: &[DVec3]) -> f64 {
-    if points.len() < 2 {
-        return f64::INFINITY;
-    }
-    let tree = build_tree(points);
-    (0..points.len())
-        .into_par_iter()
-        .map(|i| geodesic_distance(points[i], points[nearest_other(&tree, points, i)]))
-        .reduce(|| f64::INFINITY, f64::min)
-}
-
 /// Normalised separation `√N · min_{i≠j} d(x_i, x_j)` (geodesic).
 ///
 /// Each point's nearest neighbour is found with a k-d tree on the 3-D
@@ -101,33 +90,75 @@ fn min_geodesic(points: &[DVec3]) -> f64 {
 /// assert_eq!(separation(&[glam::DVec3::Z]), f64::INFINITY);
 /// ```
 pub fn separation(points: &[DVec3]) -> f64 {
-    if points.is_empty() {
-        return f64::NAN;
-    }
-    min_geodesic(points) * (points.len() as f64).sqrt()
+    neighbourhoods(points, (true, false), None, &quiet).0 * (points.len() as f64).sqrt()
 }
 
-/// Sum over unordered pairs of `f(x_i, x_j)` in double-double, parallel over
-/// rows. Returns `None` if `f` returned a non-finite value.
-fn pair_sum(points: &[DVec3], f: impl Fn(DVec3, DVec3) -> f64 + Sync) -> Option<Dd> {
-    let n = points.len();
-    (0..n)
+/// Sums over unordered pairs of the `K` values `f(x_i, x_j)`, in
+/// double-double, parallel over rows; each row's pairs are added to
+/// `tally`. A non-finite `f` makes its sum non-finite.
+fn pair_sums<const K: usize>(
+    points: &[DVec3],
+    f: impl Fn(DVec3, DVec3) -> [f64; K] + Sync,
+    tally: &Tally,
+) -> [Dd; K] {
+    (0..points.len())
         .into_par_iter()
         .map(|i| {
             let p = points[i];
-            let mut acc = Dd::ZERO;
-            for &q in &points[i + 1..] {
-                acc.add(f(p, q));
+            // four independent accumulators, so that their dependency
+            // chains overlap
+            let mut lanes = [[Dd::ZERO; K]; 4];
+            let mut chunks = points[i + 1..].chunks_exact(4);
+            for c in &mut chunks {
+                for (lane, &q) in lanes.iter_mut().zip(c) {
+                    lane.iter_mut().zip(f(p, q)).for_each(|(a, v)| a.add(v));
+                }
             }
-            acc.value().is_finite().then_some(acc)
+            for &q in chunks.remainder() {
+                lanes[0].iter_mut().zip(f(p, q)).for_each(|(a, v)| a.add(v));
+            }
+            tally.add((points.len() - 1 - i) as u64);
+            std::array::from_fn(|k| {
+                (lanes[0][k].plus(lanes[1][k])).plus(lanes[2][k].plus(lanes[3][k]))
+            })
         })
         .reduce(
-            || Some(Dd::ZERO),
-            |a, b| match (a, b) {
-                (Some(a), Some(b)) => Some(a.plus(b)),
-                _ => None,
-            },
+            || [Dd::ZERO; K],
+            |a, b| std::array::from_fn(|k| a[k].plus(b[k])),
         )
+}
+
+/// Number of unordered pairs of `n` points.
+fn pairs(n: usize) -> u64 {
+    (n as u64) * (n as u64).saturating_sub(1) / 2
+}
+
+/// D from the sum of chordal distances over unordered pairs.
+fn cap_discrepancy_from(n: usize, half_sum: Dd) -> f64 {
+    if n == 0 || !half_sum.value().is_finite() {
+        return f64::NAN;
+    }
+    // Σ_{i,j} = 2 · half_sum, so D² = 1/3 − half_sum / (2 N²).
+    let nf = n as f64;
+    let term = half_sum.div(2.0 * nf).div(nf);
+    let d2 = Dd::ratio(1.0, 3.0).plus(term.neg()).value();
+    d2.max(0.0).sqrt()
+}
+
+/// (E − N²) / N^1.5 from the energy over unordered pairs.
+fn riesz1_from(n: usize, half_energy: Dd) -> f64 {
+    if n == 0 {
+        return f64::NAN;
+    }
+    if !half_energy.value().is_finite() {
+        return f64::INFINITY;
+    }
+    let nf = n as f64;
+    let e = half_energy.plus(half_energy);
+    let mut n2 = Dd::ZERO;
+    n2.add(nf * nf);
+    n2.add(nf.mul_add(nf, -(nf * nf)));
+    e.plus(n2.neg()).value() / nf.powf(1.5)
 }
 
 /// Spherical-cap L2 discrepancy D via Stolarsky's invariance principle:
@@ -157,18 +188,9 @@ fn pair_sum(points: &[DVec3], f: impl Fn(DVec3, DVec3) -> f64 + Sync) -> Option<
 /// assert!((d - (1.0f64 / 12.0).sqrt()).abs() < 1e-15);
 /// ```
 pub fn cap_discrepancy_l2(points: &[DVec3]) -> f64 {
-    let n = points.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    let Some(half_sum) = pair_sum(points, |p, q| (p - q).length()) else {
-        return f64::NAN; // non-finite input
-    };
-    // Σ_{i,j} = 2 · half_sum, so D² = 1/3 − half_sum / (2 N²).
-    let nf = n as f64;
-    let term = half_sum.div(2.0 * nf).div(nf);
-    let d2 = Dd::ratio(1.0, 3.0).plus(term.neg()).value();
-    d2.max(0.0).sqrt()
+    let tally = Tally::new("pairs", pairs(points.len()), &quiet);
+    let [half_sum] = pair_sums(points, |p, q| [(p - q).length()], &tally);
+    cap_discrepancy_from(points.len(), half_sum)
 }
 
 /// Normalised Riesz s = 1 energy `(E − N²) / N^1.5`, with
@@ -189,34 +211,9 @@ pub fn cap_discrepancy_l2(points: &[DVec3]) -> f64 {
 /// assert!((r - (-3.0 / 8f64.sqrt())).abs() < 1e-15);
 /// ```
 pub fn riesz1_normalized(points: &[DVec3]) -> f64 {
-    let n = points.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    let Some(half_energy) = pair_sum(points, |p, q| 1.0 / (p - q).length()) else {
-        return f64::INFINITY;
-    };
-    let nf = n as f64;
-    let e = half_energy.plus(half_energy);
-    let mut n2 = Dd::ZERO;
-    n2.add(nf * nf);
-    n2.add(nf.mul_add(nf, -(nf * nf)));
-    e.plus(n2.neg()).value() / nf.powf(1.5)
-}
-
-/// Unnormalised covering radius (radians); NaN for an empty set.
-fn covering_angle(points: &[DVec3]) -> f64 {
-    let n = points.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    let tree = (n > 64).then(|| build_tree(points));
-    (0..n)
-        .into_par_iter()
-        .map_init(Vec::new, |normals, i| {
-            cell_of(points, tree.as_ref(), i, normals)
-        })
-        .reduce(|| 0.0, f64::max)
+    let tally = Tally::new("pairs", pairs(points.len()), &quiet);
+    let [half_energy] = pair_sums(points, |p, q| [1.0 / (p - q).length()], &tally);
+    riesz1_from(points.len(), half_energy)
 }
 
 /// Normalised covering radius `√N · max_{y ∈ S²} min_i d(y, x_i)` (geodesic).
@@ -231,7 +228,9 @@ fn covering_angle(points: &[DVec3]) -> f64 {
 /// charts of the cube map with all points, where edge interiors and the
 /// antipode are also candidates, so any input (N ≥ 1, clusters, coincident
 /// points, all points on a great circle) is handled. Cost O(N log N) for
-/// well-spread sets (O(N) per wide cell otherwise), parallel.
+/// well-spread sets (O(N) per wide cell otherwise), parallel; the cells are
+/// visited along a Morton curve, so that consecutive queries share the
+/// tree's nodes in cache.
 ///
 /// Returns NaN for an empty set and π for one point. For reference, the
 /// hexagonal lattice of the same density gives `√(8π / (3√3)) ≈ 2.199` and
@@ -246,7 +245,7 @@ fn covering_angle(points: &[DVec3]) -> f64 {
 /// assert!((c - (1.0 / 3f64.sqrt()).acos()).abs() < 1e-14);
 /// ```
 pub fn covering_radius(points: &[DVec3]) -> f64 {
-    covering_angle(points) * (points.len() as f64).sqrt()
+    neighbourhoods(points, (false, true), None, &quiet).1 * (points.len() as f64).sqrt()
 }
 
 /// Mesh ratio `2 · covering / min distance` (both unnormalised geodesic
@@ -265,7 +264,8 @@ pub fn mesh_ratio(points: &[DVec3]) -> f64 {
     if points.len() < 2 {
         return f64::NAN;
     }
-    2.0 * covering_angle(points) / min_geodesic(points)
+    let (min_angle, cover_angle) = neighbourhoods(points, (true, true), None, &quiet);
+    2.0 * cover_angle / min_angle
 }
 
 /// Angular power spectrum `P(l) = (1/N) Σ_{i,j} P_l(x_i · x_j)` for
@@ -290,7 +290,25 @@ pub fn mesh_ratio(points: &[DVec3]) -> f64 {
 /// assert!(p[4] > 1.0);
 /// ```
 pub fn angular_power(points: &[DVec3], l_max: usize) -> Vec<f64> {
+    angular_power_with(points, l_max, &quiet)
+}
+
+/// [`angular_power`], telling `progress` how many of the pairs are done
+/// (stage `"spectrum"`).
+///
+/// ```
+/// use std::sync::atomic::{AtomicU64, Ordering};
+/// use tessera::baselines::spherical_fibonacci;
+/// use tessera::metrics::sphere::angular_power_with;
+/// let done = AtomicU64::new(0);
+/// let p = angular_power_with(&spherical_fibonacci(100), 8, &|_, d, _| {
+///     done.fetch_max(d, Ordering::Relaxed);
+/// });
+/// assert_eq!((p.len(), done.into_inner()), (9, 100 * 99 / 2));
+/// ```
+pub fn angular_power_with(points: &[DVec3], l_max: usize, progress: Progress) -> Vec<f64> {
     let n = points.len();
+    let tally = Tally::new("spectrum", pairs(n), progress);
     let len = l_max + 1;
     if n == 0 {
         return vec![0.0; len];
@@ -352,6 +370,7 @@ pub fn angular_power(points: &[DVec3], l_max: usize) -> Vec<f64> {
                     }
                 }
                 acc.iter_mut().zip(&row).for_each(|(x, y)| *x += y);
+                tally.add(rest.len() as u64);
                 (acc, row)
             },
         )
@@ -367,79 +386,263 @@ pub fn angular_power(points: &[DVec3], l_max: usize) -> Vec<f64> {
     off_diag.iter().map(|s| (nf + 2.0 * s) / nf).collect()
 }
 
-/// Summary of the sphere metrics of one point set (serialisable).
+/// The measures of [`measure`], by their keys in reports.
 ///
 /// ```
-/// use tessera::baselines::spherical_fibonacci;
-/// use tessera::metrics::sphere::sphere_report;
-/// let r = sphere_report(&spherical_fibonacci(100));
-/// assert_eq!(r.n, 100);
-/// println!("{}", serde_json::to_string(&r).unwrap());
+/// use tessera::metrics::{Measure, SphereMeasure};
+/// let keys: Vec<_> = SphereMeasure::ALL.iter().map(|m| m.key()).collect();
+/// assert_eq!(keys[0], "separation_sqrt_n");
 /// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SphereMeasure {
+    /// [`separation`].
+    Separation,
+    /// [`cap_discrepancy_l2`].
+    CapDiscrepancy,
+    /// [`riesz1_normalized`].
+    Energy,
+    /// [`covering_radius`].
+    Covering,
+    /// [`mesh_ratio`].
+    MeshRatio,
+}
+
+impl Measure for SphereMeasure {
+    const ALL: &'static [Self] = &[
+        SphereMeasure::Separation,
+        SphereMeasure::CapDiscrepancy,
+        SphereMeasure::Energy,
+        SphereMeasure::Covering,
+        SphereMeasure::MeshRatio,
+    ];
+
+    fn key(self) -> &'static str {
+        match self {
+            SphereMeasure::Separation => "separation_sqrt_n",
+            SphereMeasure::CapDiscrepancy => "cap_discrepancy_l2",
+            SphereMeasure::Energy => "riesz1_excess_over_n1_5",
+            SphereMeasure::Covering => "covering_radius_sqrt_n",
+            SphereMeasure::MeshRatio => "mesh_ratio",
+        }
+    }
+
+    fn meaning(self) -> &'static str {
+        match self {
+            SphereMeasure::Separation => {
+                "sqrt(N) x the smallest geodesic angle between two points (radians). \
+                 Higher is better: spherical Fibonacci 3.092 at N = 3072, independent \
+                 uniform points near 0. Cost O(N log N)."
+            }
+            SphereMeasure::CapDiscrepancy => {
+                "Spherical-cap L2 discrepancy D, not normalised: \
+                 D^2 = 1/3 - sum over all ordered pairs of |x_i - x_j| / (4 N^2) \
+                 (Stolarsky, chordal distances). Lower is better: spherical Fibonacci \
+                 1.092e-3 at N = 3072, uniform random 1.348e-2. Cost O(N^2)."
+            }
+            SphereMeasure::Energy => {
+                "(E - N^2) / N^1.5 with E = sum over ordered pairs i != j of \
+                 1 / |x_i - x_j| (Riesz s = 1 energy, chordal): N^2 is the energy of \
+                 the uniform measure, so this is the next term. Lower is better: \
+                 spherical Fibonacci -1.100 at N = 3072, independent uniform points \
+                 near 0. Cost O(N^2)."
+            }
+            SphereMeasure::Covering => {
+                "sqrt(N) x the covering radius: the largest geodesic angle (radians) \
+                 from a point of the sphere to its nearest sample, exact (spherical \
+                 Voronoi cells). Lower is better: hexagonal lattice \
+                 sqrt(8 pi / (3 sqrt 3)) = 2.199, spherical Fibonacci 2.728 at \
+                 N = 3072. Cost O(N log N)."
+            }
+            SphereMeasure::MeshRatio => {
+                "2 x covering radius / smallest distance (both geodesic angles), \
+                 dimensionless, at least 1: hexagonal lattice 2 / sqrt 3 = 1.155, \
+                 spherical Fibonacci 1.764 at N = 3072; infinite when two points \
+                 coincide. Lower is better. Cost O(N log N)."
+            }
+        }
+    }
+
+    fn quadratic(self) -> bool {
+        matches!(self, SphereMeasure::CapDiscrepancy | SphereMeasure::Energy)
+    }
+}
+
+/// A point's spacing scale: angles near it are multiplied by it.
+type Scale<'a> = &'a (dyn Fn(DVec3) -> f64 + Sync);
+
+/// Smallest geodesic angle between two points and covering radius
+/// (radians) in one pass over one k-d tree, visiting the points in
+/// [`spatial_order`] for cache locality; each is computed only if asked
+/// for (NaN otherwise). With a `scale`, each nearest-neighbour angle is
+/// multiplied by the larger scale of its two ends, and each cell's radius
+/// by the scale at its farthest point. Empty set: NaN, NaN; one point:
+/// +∞, π.
+fn neighbourhoods(
+    points: &[DVec3],
+    (min, cover): (bool, bool),
+    scale: Option<Scale>,
+    progress: Progress,
+) -> (f64, f64) {
+    let n = points.len();
+    match n {
+        0 => return (f64::NAN, f64::NAN),
+        1 => return (f64::INFINITY, PI),
+        _ => {}
+    }
+    let sorted: Vec<DVec3> = spatial_order(points)
+        .into_par_iter()
+        .map(|i| points[i])
+        .collect();
+    let tree = build_tree(&sorted);
+    let tally = Tally::new("neighbours", n as u64, progress);
+    let at = |x: DVec3| scale.map_or(1.0, |s| s(x));
+    let (min_angle, cover_angle) = (0..n)
+        .into_par_iter()
+        .map_init(Vec::new, |normals, i| {
+            // the covering cell's neighbours include the nearest one
+            let (c, nearest) = if cover {
+                let cell = cell_of(&sorted, (n > 64).then_some(&tree), i, normals);
+                (cell.radius * at(cell.farthest), cell.nearest)
+            } else {
+                (f64::NAN, Some(nearest_other(&tree, &sorted, i)))
+            };
+            let d = match (min, nearest) {
+                (true, Some(j)) => {
+                    geodesic_distance(sorted[i], sorted[j]) * at(sorted[i]).max(at(sorted[j]))
+                }
+                _ => f64::NAN,
+            };
+            tally.add(1);
+            (d, c)
+        })
+        .reduce(|| (f64::INFINITY, 0.0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    (
+        if min { min_angle } else { f64::NAN },
+        if cover { cover_angle } else { f64::NAN },
+    )
+}
+
+/// Separation, covering radius and mesh ratio in units of the spacing a
+/// density asks for where they are measured (what `tessera sphere
+/// --report` prints); see [`local_spacing`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct SphereReport {
-    /// Number of points.
-    pub n: usize,
-    /// [`separation`]: √N · minimum geodesic distance.
+pub struct LocalSpacing {
+    /// The smallest nearest-neighbour angle times `√(4π N pdf)`, the pdf
+    /// the larger of the pair's two ends.
     pub separation: f64,
-    /// [`cap_discrepancy_l2`]: spherical-cap L2 discrepancy (Stolarsky).
-    pub cap_discrepancy_l2: f64,
-    /// [`riesz1_normalized`]: (E − N²) / N^1.5 for the s = 1 Riesz energy.
-    pub riesz1_normalized: f64,
-    /// [`covering_radius`]: √N · covering radius (geodesic).
+    /// The largest Voronoi cell radius times `√(4π N pdf)` at the cell's
+    /// farthest point (0 where the pdf is 0: no sample is owed there).
     pub covering_radius: f64,
-    /// [`mesh_ratio`]: 2 · covering radius / minimum distance.
+    /// `2 · covering_radius / separation`.
     pub mesh_ratio: f64,
 }
 
-/// Computes every field of [`SphereReport`]; cost dominated by the two
-/// O(N²/2) sums (about 0.1 s for N = 10⁴ on two cores).
+/// The measures of [`LocalSpacing`] for points drawn with `pdf` (per
+/// steradian): every angle is multiplied by `√(4π N pdf)`, which is `√N`
+/// for a uniform pdf, so that a set following a density exactly reads as
+/// a uniform set of the same quality would: for a uniform pdf the fields
+/// equal [`separation`], [`covering_radius`] and [`mesh_ratio`]. A
+/// piecewise-constant density (regions, maps) measures each level in its
+/// own spacing, as `examples/geodesy.rs` does per level. Cost
+/// O(N log N) plus 3N evaluations of `pdf`.
 ///
 /// ```
+/// use std::f64::consts::PI;
 /// use tessera::baselines::spherical_fibonacci;
-/// use tessera::metrics::sphere_report;
-/// let r = sphere_report(&spherical_fibonacci(300));
-/// assert!((r.mesh_ratio - 2.0 * r.covering_radius / r.separation).abs() < 1e-12);
+/// use tessera::metrics::sphere::{local_spacing, separation};
+/// let points = spherical_fibonacci(1000);
+/// let local = local_spacing(&points, |_| 1.0 / (4.0 * PI));
+/// assert!((local.separation - separation(&points)).abs() < 1e-12);
 /// ```
-pub fn sphere_report(points: &[DVec3]) -> SphereReport {
-    sphere_report_up_to(points, usize::MAX)
+pub fn local_spacing(points: &[DVec3], pdf: impl Fn(DVec3) -> f64 + Sync) -> LocalSpacing {
+    let n = points.len() as f64;
+    let scale = |x: DVec3| (4.0 * PI * n * pdf(x).max(0.0)).sqrt();
+    let (separation, covering_radius) = neighbourhoods(points, (true, true), Some(&scale), &quiet);
+    LocalSpacing {
+        separation,
+        covering_radius,
+        mesh_ratio: if points.len() < 2 {
+            f64::NAN
+        } else {
+            2.0 * covering_radius / separation
+        },
+    }
 }
 
-/// [`sphere_report`] with the two O(N²) measures (cap discrepancy and
-/// energy) only up to `pair_limit` points: NaN (JSON `null`) beyond it,
-/// so that large sets cost O(N log N).
+/// The measures `options` ask for (all by default, the O(N²) ones only up
+/// to [`Options::pairs_up_to`] points), sharing work between them: one
+/// k-d tree pass for separation, covering radius and mesh ratio, one pair
+/// pass for cap discrepancy and energy. Values equal those of the
+/// functions named in [`SphereMeasure`] (up to rounding for the mesh
+/// ratio).
 ///
 /// ```
 /// use tessera::baselines::spherical_fibonacci;
-/// use tessera::metrics::sphere::sphere_report_up_to;
-/// let r = sphere_report_up_to(&spherical_fibonacci(300), 100);
-/// assert!(r.riesz1_normalized.is_nan() && r.separation > 3.0);
+/// use tessera::metrics::{sphere, Options, SphereMeasure};
+/// let points = spherical_fibonacci(300);
+/// let options = Options { pairs_up_to: 100, ..Options::default() };
+/// let r = sphere::measure(&points, &options);
+/// assert_eq!(r.get(SphereMeasure::Energy), None);
+/// assert_eq!(r[SphereMeasure::Covering], sphere::covering_radius(&points));
 /// ```
-pub fn sphere_report_up_to(points: &[DVec3], pair_limit: usize) -> SphereReport {
+pub fn measure(points: &[DVec3], options: &Options<SphereMeasure>) -> Report<SphereMeasure> {
+    use SphereMeasure::*;
     let n = points.len();
-    let pairs = n <= pair_limit;
-    let nf = (n as f64).sqrt();
-    let min_d = min_geodesic(points);
-    let cover = covering_angle(points);
-    let (separation, covering_radius, mesh_ratio) = match n {
-        0 => (f64::NAN, f64::NAN, f64::NAN),
-        1 => (f64::INFINITY, PI, f64::NAN),
-        _ => (min_d * nf, cover * nf, 2.0 * cover / min_d),
+    let computes = |m| options.computes(m, n);
+    let (min_angle, cover_angle) = neighbourhoods(
+        points,
+        (
+            computes(Separation) || computes(MeshRatio),
+            computes(Covering) || computes(MeshRatio),
+        ),
+        None,
+        options.progress,
+    );
+    // one pass for both sums, each only if asked for
+    let tally = || Tally::new("pairs", pairs(n), options.progress);
+    let [half_sum, half_energy] = match (computes(CapDiscrepancy), computes(Energy)) {
+        (false, false) => [Dd::ZERO; 2],
+        (true, false) => [
+            pair_sums(points, |p, q| [(p - q).length()], &tally())[0],
+            Dd::ZERO,
+        ],
+        (false, true) => [
+            Dd::ZERO,
+            pair_sums(points, |p, q| [1.0 / (p - q).length()], &tally())[0],
+        ],
+        (true, true) => pair_sums(
+            points,
+            |p, q| {
+                let d = (p - q).length();
+                [d, 1.0 / d]
+            },
+            &tally(),
+        ),
     };
-    SphereReport {
-        n,
-        separation,
-        cap_discrepancy_l2: if pairs {
-            cap_discrepancy_l2(points)
-        } else {
-            f64::NAN
-        },
-        riesz1_normalized: if pairs {
-            riesz1_normalized(points)
-        } else {
-            f64::NAN
-        },
-        covering_radius,
-        mesh_ratio,
-    }
+    let root_n = (n as f64).sqrt();
+    Report::new(n, options, |m| match m {
+        Separation => min_angle * root_n,
+        CapDiscrepancy => cap_discrepancy_from(n, half_sum),
+        Energy => riesz1_from(n, half_energy),
+        Covering => cover_angle * root_n,
+        MeshRatio if n < 2 => f64::NAN,
+        MeshRatio => 2.0 * cover_angle / min_angle,
+    })
+}
+
+/// Every measure of [`SphereMeasure`], whatever N (the O(N²) ones cost
+/// about 0.1 s for N = 10⁴ on two cores).
+///
+/// ```
+/// use tessera::baselines::spherical_fibonacci;
+/// use tessera::metrics::{sphere_report, SphereMeasure::*};
+/// let r = sphere_report(&spherical_fibonacci(300));
+/// assert!((r[MeshRatio] - 2.0 * r[Covering] / r[Separation]).abs() < 1e-12);
+/// ```
+pub fn sphere_report(points: &[DVec3]) -> Report<SphereMeasure> {
+    let options = Options {
+        pairs_up_to: usize::MAX,
+        ..Options::default()
+    };
+    measure(points, &options)
 }

@@ -1,19 +1,22 @@
 //! Pictures a user looks at before reading numbers: planar stipples, sphere
-//! views (equirectangular and orthographic), periodogram images and line
-//! plots (linear or log-log, several series, ticks with small numeric
-//! labels). Pure functions returning image buffers; saving is the caller's.
+//! views (equirectangular and orthographic, samples over their map),
+//! periodogram images and line plots (linear or log-log, several series
+//! with markers and a legend, ticks, a title and axis names in an 8x8
+//! bitmap font). Pure functions returning image buffers; saving is the caller's.
 //!
 //! ```
-//! use tessera::plot::{line_plot, stipple, Axes, Series};
+//! use tessera::plot::{line_plot, stipple, Axes, Labels, Marker, Series};
 //! let img = stipple(&[glam::DVec2::new(0.5, 0.5)], 64);
 //! assert_eq!(img.dimensions(), (64, 64));
-//! let s = Series { points: vec![(1.0, 1.0), (10.0, 0.1)], color: [200, 0, 0] };
-//! let plot = line_plot(&[s], Axes { log_x: true, log_y: true }, 320, 240);
+//! let s = Series { points: vec![(1.0, 1.0), (10.0, 0.1)], color: [200, 0, 0], name: String::new(), marker: Marker::Square };
+//! let plot = line_plot(&[s], Axes { log_x: true, log_y: true }, &Labels::default(), 320, 240);
 //! assert_eq!(plot.dimensions(), (320, 240));
 //! ```
 
 pub mod svg;
 
+use crate::density::envmap::Up;
+use crate::lights::RgbMap;
 use glam::{DVec2, DVec3};
 use image::{GrayImage, Luma, Rgb, RgbImage};
 use std::f64::consts::{PI, TAU};
@@ -102,26 +105,127 @@ pub fn stipple(points: &[DVec2], size: u32) -> GrayImage {
     img
 }
 
-/// Equirectangular view of points on the unit sphere, `width x width/2`:
-/// longitude `atan2(y, x)` from −180° (left edge) to 180°, colatitude from
-/// the north pole `+z` (top row) to the south pole.
+/// Pixel `(column, row)` of direction `m` (map frame, +Z up) in a
+/// `width x height` lat-long image with the map convention of
+/// [`EnvMap`](crate::density::envmap): `phi = atan2(y, x) mod 2π` from 0 at
+/// the left edge, `theta` from +Z at the top row.
+fn lat_long_pixel(m: DVec3, width: u32, height: u32) -> (i64, i64) {
+    // + 0 turns −0 into +0: the poles at phi = 0
+    let phi = (m.y + 0.0).atan2(m.x + 0.0).rem_euclid(TAU);
+    let theta = m.z.clamp(-1.0, 1.0).acos();
+    (pixel(phi / TAU, width), pixel(theta / PI, height))
+}
+
+/// Equirectangular view of points on the unit sphere, `width x width/2`,
+/// in the lat-long map convention (column 0 at `phi = atan2(y, x) = 0`,
+/// phi growing to the right; the north pole `+z` at the top row), so that
+/// it lines up with the map a set was drawn from (see [`over_map`]).
 ///
 /// # Example
 /// ```
 /// use glam::DVec3;
-/// let img = tessera::plot::equirectangular(&[DVec3::X, DVec3::Z], 200);
+/// let img = tessera::plot::equirectangular(&[DVec3::X, DVec3::Z, -DVec3::X], 200);
 /// assert_eq!(img.dimensions(), (200, 100));
-/// assert_eq!(img.get_pixel(100, 50)[0], 0); // +x: longitude 0 on the equator
-/// assert_eq!(img.get_pixel(100, 0)[0], 0); // the north pole
+/// assert_eq!(img.get_pixel(0, 50)[0], 0); // +x: phi 0, the left edge, on the equator
+/// assert_eq!(img.get_pixel(100, 50)[0], 0); // −x: phi = π, the middle
+/// assert_eq!(img.get_pixel(0, 0)[0], 0); // the north pole
 /// ```
 pub fn equirectangular(points: &[DVec3], width: u32) -> GrayImage {
     let height = (width / 2).max(1);
     let (mut img, radius) = canvas(width, height, points.len());
     for p in points.iter().filter(|p| p.is_finite()) {
-        let lon = (p.y + 0.0).atan2(p.x + 0.0); // + 0 turns −0 into +0: the poles at longitude 0
-        let colat = p.z.clamp(-1.0, 1.0).acos();
-        let (col, row) = (pixel((lon + PI) / TAU, width), pixel(colat / PI, height));
+        let (col, row) = lat_long_pixel(*p, width, height);
         dot(&mut img, col, row, radius, BLACK);
+    }
+    img
+}
+
+/// A lat-long map for display, `width x width/2`: each output pixel the
+/// mean of the map pixels it covers, scaled so that the mean luminance
+/// reads 0.18 (the map's level, whatever its units), compressed by
+/// Reinhard's `v / (1 + v)` per channel and encoded as sRGB.
+///
+/// # Example
+/// ```
+/// use tessera::lights::RgbMap;
+/// let map = RgbMap { width: 4, height: 2, rgb: vec![[2.0, 2.0, 2.0]; 8], bad_samples: 0 };
+/// let img = tessera::plot::tone_map(&map, 8);
+/// assert_eq!(img.dimensions(), (8, 4));
+/// // 0.18 / (1 + 0.18) in sRGB
+/// assert!(img.pixels().all(|p| p.0 == [109, 109, 109]));
+/// ```
+pub fn tone_map(map: &RgbMap, width: u32) -> RgbImage {
+    let height = (width / 2).max(1);
+    let luminance = map.luminance();
+    let mean = luminance.iter().sum::<f64>() / luminance.len().max(1) as f64;
+    let scale = if mean > 0.0 { 0.18 / mean } else { 1.0 };
+    let srgb = |v: f64| {
+        let v = (v / (1.0 + v)).clamp(0.0, 1.0);
+        let e = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (e * 255.0).round() as u8
+    };
+    // the map pixels [lo, hi) an output pixel k of n covers
+    let span = |k: u32, n: u32, len: usize| {
+        let lo = k as usize * len / n as usize;
+        (
+            lo,
+            (((k + 1) as usize * len).div_ceil(n as usize))
+                .max(lo + 1)
+                .min(len),
+        )
+    };
+    RgbImage::from_fn(width, height, |x, y| {
+        let (c0, c1) = span(x, width, map.width);
+        let (r0, r1) = span(y, height, map.height);
+        let mut sum = [0.0f64; 3];
+        for row in r0..r1 {
+            for p in &map.rgb[row * map.width + c0..row * map.width + c1] {
+                (0..3).for_each(|c| sum[c] += f64::from(p[c]).max(0.0));
+            }
+        }
+        let count = ((r1 - r0) * (c1 - c0)).max(1) as f64;
+        Rgb(sum.map(|v| srgb(v / count * scale)))
+    })
+}
+
+/// Samples drawn over the map they were drawn from: the [`tone_map`] of
+/// `map` (`width x width/2`) with each point a red dot (3x3, outlined in
+/// black, when there are at least 64 pixels a point) at its map pixel;
+/// `up` is the map's up axis, as when sampling it.
+///
+/// # Example
+/// ```
+/// use glam::DVec3;
+/// use tessera::{density::envmap::Up, lights::RgbMap};
+/// let map = RgbMap { width: 8, height: 4, rgb: vec![[1.0; 3]; 32], bad_samples: 0 };
+/// let img = tessera::plot::over_map(&[DVec3::X], &map, Up::Z, 64);
+/// assert_eq!(img.get_pixel(1, 16).0, [255, 0, 0]); // phi 0 on the equator
+/// ```
+pub fn over_map(points: &[DVec3], map: &RgbMap, up: Up, width: u32) -> RgbImage {
+    let mut img = tone_map(map, width);
+    let (w, h) = img.dimensions();
+    let big = (w as usize * h as usize) >= 64 * points.len().max(1);
+    let pixels: Vec<(i64, i64)> = points
+        .iter()
+        .filter(|p| p.is_finite())
+        .map(|p| lat_long_pixel(up.to_map(*p), w, h))
+        .collect();
+    if big {
+        for &(col, row) in &pixels {
+            for (dx, dy) in (-2..=2).flat_map(|dx| (-2..=2).map(move |dy| (dx, dy))) {
+                put(&mut img, col + dx, row + dy, [0, 0, 0]);
+            }
+        }
+    }
+    let r = i64::from(big);
+    for &(col, row) in &pixels {
+        for (dx, dy) in (-r..=r).flat_map(|dx| (-r..=r).map(move |dy| (dx, dy))) {
+            put(&mut img, col + dx, row + dy, [255, 0, 0]);
+        }
     }
     img
 }
@@ -199,11 +303,13 @@ pub fn log_image(values: &[f64], size: usize) -> GrayImage {
     img
 }
 
-/// One curve of a [`line_plot`]: `(x, y)` points joined in order.
+/// One curve of a [`line_plot`]: `(x, y)` points joined in order, named
+/// in the legend (unless the name is empty).
 ///
 /// # Example
 /// ```
-/// let s = tessera::plot::Series { points: vec![(0.0, 1.0)], color: [0, 0, 0] };
+/// use tessera::plot::{Marker, Series};
+/// let s = Series { points: vec![(0.0, 1.0)], color: [0, 0, 0], name: "a".into(), marker: Marker::Square };
 /// assert_eq!(s.points.len(), 1);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
@@ -212,6 +318,72 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// RGB colour.
     pub color: [u8; 3],
+    /// Legend entry; empty for none.
+    pub name: String,
+    /// The mark at each point.
+    pub marker: Marker,
+}
+
+/// The mark a [`Series`] draws at each point (5 pixels across), so that
+/// series of one colour stay apart.
+///
+/// # Example
+/// ```
+/// assert_ne!(tessera::plot::Marker::Square, tessera::plot::Marker::Cross);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    /// A filled square.
+    Square,
+    /// A square outline.
+    Hollow,
+    /// A diagonal cross.
+    Cross,
+    /// An upright cross.
+    Plus,
+    /// A diamond outline.
+    Diamond,
+    /// No mark: the line alone.
+    None,
+}
+
+impl Marker {
+    /// The pixels of the mark around its centre.
+    fn offsets(self) -> Vec<(i64, i64)> {
+        let square = (-2..=2).flat_map(|dx| (-2..=2).map(move |dy| (dx, dy)));
+        match self {
+            Marker::Square => square.collect(),
+            Marker::Hollow => square
+                .filter(|(x, y)| x.abs() == 2 || y.abs() == 2)
+                .collect(),
+            Marker::Cross => (-2..=2).flat_map(|d| [(d, d), (d, -d)]).collect(),
+            Marker::Plus => (-2..=2).flat_map(|d| [(d, 0), (0, d)]).collect(),
+            Marker::Diamond => (-3i64..=3)
+                .flat_map(|d| {
+                    let e = 3 - d.abs();
+                    [(d, e), (d, -e)]
+                })
+                .collect(),
+            Marker::None => Vec::new(),
+        }
+    }
+}
+
+/// The words around a [`line_plot`]: a title above, the axes' names.
+///
+/// # Example
+/// ```
+/// let l = tessera::plot::Labels { title: "t".into(), ..Default::default() };
+/// assert!(l.x.is_empty());
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Labels {
+    /// Above the frame.
+    pub title: String,
+    /// Under the x axis.
+    pub x: String,
+    /// Beside the y axis, written upwards.
+    pub y: String,
 }
 
 /// Axis scales of a [`line_plot`].
@@ -286,35 +458,30 @@ impl Scale {
     }
 }
 
-/// 3x5 bitmaps (bit 14 top-left, row-major) of the characters tick labels use.
-fn glyph(c: char) -> Option<u16> {
-    Some(match c {
-        '0' => 0b111_101_101_101_111,
-        '1' => 0b010_110_010_010_111,
-        '2' => 0b111_001_111_100_111,
-        '3' => 0b111_001_111_001_111,
-        '4' => 0b101_101_111_001_001,
-        '5' => 0b111_100_111_001_111,
-        '6' => 0b111_100_111_101_111,
-        '7' => 0b111_001_010_010_010,
-        '8' => 0b111_101_111_101_111,
-        '9' => 0b111_101_111_001_111,
-        '-' => 0b000_000_111_000_000,
-        '.' => 0b000_000_000_000_010,
-        'e' => 0b000_111_111_100_111,
-        _ => return None,
-    })
+/// Width in pixels of `text` as [`label`] draws it.
+fn text_width(text: &str) -> i64 {
+    8 * text.chars().count() as i64
 }
 
-/// Draws `text` with its top-left corner at `(x, y)`, each font pixel 2x2.
-fn label(img: &mut RgbImage, text: &str, x: i64, y: i64) {
+/// Draws `text` (ASCII, 8x8 pixels a character) in black with its top-left
+/// corner at `(x, y)`, upright or, when `upwards`, turned a quarter left
+/// (reading bottom to top, `(x, y)` then the bottom-left corner).
+fn label(img: &mut RgbImage, text: &str, x: i64, y: i64, upwards: bool) {
     for (k, c) in text.chars().enumerate() {
-        let Some(bits) = glyph(c) else { continue };
-        for bit in 0..15 {
-            if bits >> (14 - bit) & 1 == 1 {
-                let (gx, gy) = (x + 8 * k as i64 + 2 * (bit % 3), y + 2 * (bit / 3));
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    put(img, gx + dx, gy + dy, [0, 0, 0]);
+        let rows = font8x8::legacy::BASIC_LEGACY
+            .get(c as usize)
+            .copied()
+            .unwrap_or([0; 8]);
+        for (r, bits) in rows.iter().enumerate() {
+            for b in 0..8 {
+                if bits >> b & 1 == 1 {
+                    let (along, across) = (8 * k as i64 + b, r as i64);
+                    let (px, py) = if upwards {
+                        (x + across, y - along)
+                    } else {
+                        (x + along, y + across)
+                    };
+                    put(img, px, py, [0, 0, 0]);
                 }
             }
         }
@@ -350,22 +517,46 @@ fn tick_text(v: f64, log: bool) -> String {
 }
 
 /// Several series on shared axes (`width x height`, white background):
-/// a frame, ticks with numeric labels, each series as joined points with
-/// 3x3 markers. Points that a log axis cannot show are dropped.
+/// the title above a frame, ticks with numeric labels, the axes' names,
+/// each series as joined points with its marker, and a legend of the named
+/// series in a column at the right. Points that a log axis cannot show are
+/// dropped.
 ///
 /// # Example
 /// ```
-/// use tessera::plot::{line_plot, Axes, Series};
-/// let s = Series { points: vec![(1.0, 1.0), (100.0, 0.01)], color: [255, 0, 0] };
-/// let img = line_plot(&[s], Axes { log_x: true, log_y: true }, 400, 300);
+/// use tessera::plot::{line_plot, Axes, Labels, Marker, Series};
+/// let s = Series { points: vec![(1.0, 1.0), (100.0, 0.01)], color: [255, 0, 0], name: "fit".into(), marker: Marker::Square };
+/// let labels = Labels { title: "error".into(), x: "N".into(), y: "RMSE".into() };
+/// let img = line_plot(&[s], Axes { log_x: true, log_y: true }, &labels, 400, 300);
 /// assert!(img.pixels().any(|p| p.0 == [255, 0, 0]));
 /// ```
-pub fn line_plot(series: &[Series], axes: Axes, width: u32, height: u32) -> RgbImage {
+pub fn line_plot(
+    series: &[Series],
+    axes: Axes,
+    labels: &Labels,
+    width: u32,
+    height: u32,
+) -> RgbImage {
     let all = || series.iter().flat_map(|s| s.points.iter());
     let sx = Scale::new(axes.log_x, all().map(|p| p.0));
     let sy = Scale::new(axes.log_y, all().map(|p| p.1));
     let mut img = RgbImage::from_pixel(width, height, Rgb([255, 255, 255]));
-    let (left, right, top, bottom) = (60.0, width as f64 - 12.0, 12.0, height as f64 - 30.0);
+    let named: Vec<&Series> = series.iter().filter(|s| !s.name.is_empty()).collect();
+    let legend = named
+        .iter()
+        .map(|s| text_width(&s.name))
+        .max()
+        .map(|w| w + 40);
+    let y_ticks = sy.ticks();
+    let tick_width = y_ticks
+        .iter()
+        .map(|&t| text_width(&tick_text(t, sy.log)))
+        .max()
+        .unwrap_or(0);
+    let left = (tick_width + 24) as f64;
+    let right = width as f64 - 12.0 - legend.unwrap_or(0) as f64;
+    let top = if labels.title.is_empty() { 12.0 } else { 28.0 };
+    let bottom = height as f64 - if labels.x.is_empty() { 24.0 } else { 40.0 };
     let to_px = |x: f64, y: f64| -> Option<(f64, f64)> {
         let (u, v) = (sx.unit(x)?, sy.unit(y)?);
         Some((left + u * (right - left), bottom - v * (bottom - top)))
@@ -379,86 +570,121 @@ pub fn line_plot(series: &[Series], axes: Axes, width: u32, height: u32) -> RgbI
             let x = left + u * (right - left);
             segment(&mut img, (x, bottom), (x, bottom - 6.0), [0, 0, 0]);
             let text = tick_text(t, sx.log);
-            label(
-                &mut img,
-                &text,
-                x as i64 - 4 * text.len() as i64,
-                bottom as i64 + 6,
-            );
+            let at = x as i64 - text_width(&text) / 2;
+            label(&mut img, &text, at, bottom as i64 + 5, false);
         }
     }
-    for t in sy.ticks() {
+    for t in y_ticks {
         if let Some(v) = sy.unit(t) {
             let y = bottom - v * (bottom - top);
             segment(&mut img, (left, y), (left + 6.0, y), [0, 0, 0]);
             let text = tick_text(t, sy.log);
-            label(
-                &mut img,
-                &text,
-                left as i64 - 4 - 8 * text.len() as i64,
-                y as i64 - 5,
-            );
+            let at = left as i64 - 4 - text_width(&text);
+            label(&mut img, &text, at, y as i64 - 4, false);
         }
     }
+    let middle = |lo: f64, hi: f64, text: &str| ((lo + hi) / 2.0) as i64 - text_width(text) / 2;
+    label(
+        &mut img,
+        &labels.title,
+        middle(left, right, &labels.title),
+        8,
+        false,
+    );
+    label(
+        &mut img,
+        &labels.x,
+        middle(left, right, &labels.x),
+        bottom as i64 + 20,
+        false,
+    );
+    let y_at = ((top + bottom) / 2.0) as i64 + text_width(&labels.y) / 2;
+    label(&mut img, &labels.y, 4, y_at, true);
+    let mark = |img: &mut RgbImage, (x, y): (f64, f64), s: &Series| {
+        for (dx, dy) in s.marker.offsets() {
+            put(img, x.round() as i64 + dx, y.round() as i64 + dy, s.color);
+        }
+    };
     for s in series {
         let pts: Vec<(f64, f64)> = s.points.iter().filter_map(|p| to_px(p.0, p.1)).collect();
         for w in pts.windows(2) {
             segment(&mut img, w[0], w[1], s.color);
         }
-        for &(x, y) in &pts {
-            for (dx, dy) in (-1..=1).flat_map(|dx| (-1..=1).map(move |dy| (dx, dy))) {
-                put(
-                    &mut img,
-                    x.round() as i64 + dx,
-                    y.round() as i64 + dy,
-                    s.color,
-                );
-            }
-        }
+        pts.iter().for_each(|&p| mark(&mut img, p, s));
+    }
+    for (k, s) in named.iter().enumerate() {
+        let (x, y) = (right + 12.0, top + 6.0 + 14.0 * k as f64);
+        segment(&mut img, (x, y), (x + 20.0, y), s.color);
+        mark(&mut img, (x + 10.0, y), s);
+        label(&mut img, &s.name, x as i64 + 26, y as i64 - 4, false);
     }
     img
 }
 
+/// Grey "white noise: 1" reference line from `x0` to `x1` for spectra.
+fn white_noise(x0: f64, x1: f64) -> Series {
+    Series {
+        points: vec![(x0, 1.0), (x1, 1.0)],
+        color: PALETTE[7],
+        name: "white noise".into(),
+        marker: Marker::None,
+    }
+}
+
 /// Figure for a planar point set's spectrum: the [`log_image`] of its
-/// periodogram (left, `size x size` pixels scaled to 256) beside the radial
-/// average against the frequency radius (right, linear axes, 1 = white noise
-/// drawn in grey).
+/// periodogram (left, `size x size` pixels scaled to 256, DC at the centre)
+/// beside the radial power against the frequency radius `|k|` (right,
+/// linear axes, 1 = white noise drawn in grey), both labelled.
 ///
 /// # Example
 /// ```
 /// use tessera::{baselines::uniform_random_2d, metrics::plane::PlaneSpectrum};
 /// let img = tessera::plot::plane_spectrum_figure(&PlaneSpectrum::new(&uniform_random_2d(64, 1)));
-/// assert_eq!(img.dimensions(), (768, 256));
+/// assert_eq!(img.dimensions(), (768, 280));
 /// ```
 pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) -> RgbImage {
     let side = 256u32;
     let grey = log_image(&spectrum.periodogram, spectrum.size);
     let grey = image::imageops::resize(&grey, side, side, image::imageops::FilterType::Nearest);
-    let radial: Vec<(f64, f64)> = (1..spectrum.radial_average.len())
-        .map(|r| (r as f64, spectrum.radial_average[r]))
+    let radial: Vec<(f64, f64)> = (1..spectrum.radial_power.len())
+        .map(|r| (r as f64, spectrum.radial_power[r]))
         .collect();
-    let white = vec![(1.0, 1.0), (radial.len() as f64, 1.0)];
     let series = [
-        Series {
-            points: white,
-            color: PALETTE[7],
-        },
+        white_noise(1.0, radial.len() as f64),
         Series {
             points: radial,
             color: PALETTE[1],
+            name: "radial power".into(),
+            marker: Marker::None,
         },
     ];
-    let plot = line_plot(&series, Axes::default(), 2 * side, side);
-    let mut img = RgbImage::from_pixel(3 * side, side, Rgb([255, 255, 255]));
+    let labels = Labels {
+        title: "radially averaged periodogram".into(),
+        x: "frequency |k|".into(),
+        y: "power (white noise 1)".into(),
+    };
+    let plot = line_plot(&series, Axes::default(), &labels, 2 * side, side + 24);
+    let mut img = RgbImage::from_pixel(3 * side, side + 24, Rgb([255, 255, 255]));
     for (x, y, p) in grey.enumerate_pixels() {
-        img.put_pixel(x, y, Rgb([p[0]; 3]));
+        img.put_pixel(x, y + 24, Rgb([p[0]; 3]));
     }
+    // 32 characters fit the 256 pixels
+    let caption = format!(
+        "periodogram{}, |k| <= {}",
+        if spectrum.window < 1.0 {
+            " (corner)"
+        } else {
+            ""
+        },
+        spectrum.size / 2
+    );
+    label(&mut img, &caption, 4, 8, false);
     image::imageops::overlay(&mut img, &plot, i64::from(side), 0);
     img
 }
 
-/// Plot of an angular power spectrum `P(l)` for `l ≥ 1` (linear axes;
-/// 1 = white noise drawn in grey).
+/// Plot of an angular power spectrum `P(l)` for `l ≥ 1` (linear axes,
+/// labelled; 1 = white noise drawn in grey).
 ///
 /// # Example
 /// ```
@@ -467,16 +693,19 @@ pub fn plane_spectrum_figure(spectrum: &crate::metrics::plane::PlaneSpectrum) ->
 /// ```
 pub fn angular_power_figure(power: &[f64]) -> RgbImage {
     let curve: Vec<(f64, f64)> = (1..power.len()).map(|l| (l as f64, power[l])).collect();
-    let white = vec![(1.0, 1.0), (power.len().max(2) as f64 - 1.0, 1.0)];
     let series = [
-        Series {
-            points: white,
-            color: PALETTE[7],
-        },
+        white_noise(1.0, power.len().max(2) as f64 - 1.0),
         Series {
             points: curve,
             color: PALETTE[1],
+            name: "P(l)".into(),
+            marker: Marker::Square,
         },
     ];
-    line_plot(&series, Axes::default(), 640, 360)
+    let labels = Labels {
+        title: "angular power spectrum".into(),
+        x: "degree l".into(),
+        y: "P(l) (white noise 1)".into(),
+    };
+    line_plot(&series, Axes::default(), &labels, 640, 360)
 }

@@ -28,9 +28,24 @@ pub(crate) struct RequestArgs {
     /// over seeds are unbiased; without it the output is deterministic.
     #[arg(long)]
     pub(crate) seed: Option<u64>,
+    /// Sample with this table (a `.lut` file `tessera lut build` wrote)
+    /// instead of the one built in: a rebuilt table without recompiling.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) table: Option<PathBuf>,
 }
 
 impl RequestArgs {
+    /// The `--table` file, read as a table of `system`.
+    pub(crate) fn table(
+        &self,
+        system: tessera::lut::TableSystem,
+    ) -> Result<Option<tessera::lut::Table>, Error> {
+        self.table
+            .as_deref()
+            .map(|path| tessera::lut::Table::open(path, system))
+            .transpose()
+    }
+
     /// `--unsorted` as an output order.
     pub(crate) fn order(&self) -> Order {
         if self.unsorted {
@@ -65,10 +80,26 @@ impl System {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum Domain {
-    /// Unit vectors `x y z`: separation, cap discrepancy, Riesz energy, covering radius.
+    /// Points on the unit sphere: any sphere format tessera writes (`x y z`, lonlat, csv, geojson, bin).
     Sphere,
-    /// Points `x y` in [0,1)^2: nearest-neighbour distances, discrepancies, spectrum.
+    /// Points `x y` in the unit square: any plane format tessera writes (xy, csv, bin).
     Plane,
+}
+
+/// A map's up axis (`--up`).
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum UpAxis {
+    Z,
+    Y,
+}
+
+impl From<UpAxis> for tessera::density::envmap::Up {
+    fn from(up: UpAxis) -> Self {
+        match up {
+            UpAxis::Z => tessera::density::envmap::Up::Z,
+            UpAxis::Y => tessera::density::envmap::Up::Y,
+        }
+    }
 }
 
 pub(crate) fn create(path: &Path) -> Result<Box<dyn Write>, Error> {
@@ -123,11 +154,21 @@ where
         })
 }
 
+/// A progress bar on standard error (hidden when it is not a terminal).
 pub(crate) fn progress_bar() -> ProgressBar {
     let bar = ProgressBar::new(1);
     bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({elapsed})")
+        ProgressStyle::with_template("{msg:>16} [{bar:40}] {percent:>3}% ({elapsed}, {eta} left)")
             .expect("static template"),
     );
     bar
+}
+
+/// The library's progress callback (stage, done, total) shown on `bar`.
+pub(crate) fn progress_to(bar: &ProgressBar) -> impl Fn(&str, u64, u64) + Sync + '_ {
+    move |stage: &str, done: u64, total: u64| {
+        bar.set_message(stage.to_string());
+        bar.set_length(total);
+        bar.set_position(done);
+    }
 }

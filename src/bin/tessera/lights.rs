@@ -1,7 +1,6 @@
 //! `tessera lights`: an environment map turned into N directional lights.
 
 use crate::common::*;
-use crate::sphere::UpAxis;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;

@@ -91,11 +91,7 @@ where
     R: serde::Serialize,
 {
     let bar = progress_bar();
-    let progress = |stage: &str, done: u64, total: u64| {
-        bar.set_message(stage.to_string());
-        bar.set_length(total);
-        bar.set_position(done);
-    };
+    let progress = progress_to(&bar);
     let started = std::time::Instant::now();
     let (bytes, version, report) = build(&progress)?;
     bar.finish();

@@ -48,7 +48,9 @@ enum Command {
         #[command(subcommand)]
         command: LutCommand,
     },
-    /// Quality measures of a point file (text formats tessera writes, or UTK binary).
+    /// Quality measures of a point file (any format tessera writes, or UTK binary);
+    /// `--help` lists every key.
+    #[command(after_long_help = metrics::measures_help())]
     Metrics(MetricsArgs),
     /// Render a point file as a PNG picture.
     Plot(PlotArgs),

@@ -63,6 +63,7 @@ pub(crate) fn plane(args: PlaneArgs) -> Result<(), Error> {
             .as_deref()
             .map(tessera::density::rectangle::Rectangle::parse)
             .transpose()?,
+        table: args.request.table(system.table_system())?,
     };
     let pdf = request.pdf(&*density);
     let output = &args.request.output;

@@ -15,8 +15,9 @@ pub(crate) struct PlotArgs {
     /// The PNG to write.
     #[arg(long)]
     png: PathBuf,
-    /// Sphere view: equirectangular (lon/lat) or orthographic (the
-    /// hemisphere facing --toward).
+    /// Sphere view: equirectangular (the lat-long map convention: phi =
+    /// atan2(y, x) from 0 at the left edge, +z at the top) or orthographic
+    /// (the hemisphere facing --toward).
     #[arg(long, value_enum, default_value = "equirect")]
     view: View,
     /// Orthographic view direction `LON,LAT` in degrees.
@@ -25,6 +26,15 @@ pub(crate) struct PlotArgs {
     /// Image width in pixels.
     #[arg(long, default_value_t = 1024)]
     size: u32,
+    /// Sphere, equirect view: draw the points in red over this lat-long
+    /// map (OpenEXR, Radiance .hdr or PNG), tone-mapped, in the map's own
+    /// convention (column 0 at phi = atan2(y, x) = 0), as `tessera sphere
+    /// --map` reads it.
+    #[arg(long, value_name = "MAP")]
+    over: Option<PathBuf>,
+    /// The --over map's up axis, as given to `tessera sphere --up`.
+    #[arg(long, value_enum, default_value = "z", requires = "over")]
+    up: UpAxis,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -36,13 +46,26 @@ pub(crate) enum View {
 pub(crate) fn plot(args: PlotArgs) -> Result<(), Error> {
     use tessera::plot;
     match (args.domain, args.view) {
+        (Domain::Plane, _) if args.over.is_some() => Err(Error::Request(
+            "--over draws sphere points over a lat-long map; it does not apply to plane".into(),
+        )),
+        (Domain::Sphere, View::Ortho) if args.over.is_some() => Err(Error::Request(
+            "--over applies to --view equirect (the map's own projection)".into(),
+        )),
         (Domain::Plane, _) => {
             let points = read_plane_points(&args.file)?;
             save_png(&plot::stipple(&points, args.size), &args.png)
         }
         (Domain::Sphere, View::Equirect) => {
             let points = read_sphere_points(&args.file)?;
-            save_png(&plot::equirectangular(&points, args.size), &args.png)
+            match &args.over {
+                Some(map) => {
+                    let (rgb, _) = tessera::lights::read_rgb(map, &Default::default())?;
+                    let img = plot::over_map(&points, &rgb, args.up.into(), args.size);
+                    save_png(&img, &args.png)
+                }
+                None => save_png(&plot::equirectangular(&points, args.size), &args.png),
+            }
         }
         (Domain::Sphere, View::Ortho) => {
             let points = read_sphere_points(&args.file)?;

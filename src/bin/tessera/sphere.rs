@@ -2,7 +2,7 @@
 
 use crate::common::*;
 use clap::builder::PossibleValuesParser;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use tessera::density::sphere::Cap;
@@ -68,15 +68,11 @@ pub(crate) struct SphereArgs {
     #[arg(long, value_name = "K", default_value_t = 0)]
     relax: usize,
     /// Print the set's separation, covering radius and mesh ratio (and a
-    /// map's integral) to standard error.
+    /// map's integral) to standard error, each angle in units of the local
+    /// spacing the density asks for: times sqrt(4 pi N pdf), which is
+    /// sqrt(N) for a uniform request (see `tessera metrics --help`).
     #[arg(long)]
     report: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-pub(crate) enum UpAxis {
-    Z,
-    Y,
 }
 
 pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
@@ -105,6 +101,7 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
         seed: args.request.seed,
         within: args.within.as_deref().map(Cap::window).transpose()?,
         relax: args.relax,
+        table: args.request.table(tessera::lut::TableSystem::Sphere)?,
     };
     let pdf = density.pdf();
     let output = &args.request.output;
@@ -133,7 +130,7 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
                 map.coordsys().unwrap_or("not given")
             );
         }
-        print_report(&points);
+        print_report(&points, &pdf);
         write(&mut points.into_iter())
     } else {
         request.with_points(&density, write)?
@@ -154,24 +151,16 @@ fn open_map(path: &Path, args: &SphereArgs) -> Result<tessera::density::envmap::
     Ok(map)
 }
 
-/// Separation, covering radius and mesh ratio of a point set (the O(N log N)
-/// measures of `tessera::metrics::sphere`), to standard error.
-pub(crate) fn print_report(points: &[glam::DVec3]) {
-    use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
+/// Separation, covering radius and mesh ratio of a request's points in
+/// units of the spacing its density asks for, to standard error.
+fn print_report(points: &[glam::DVec3], pdf: &(dyn Fn(glam::DVec3) -> f64 + Sync)) {
+    let local = tessera::metrics::sphere::local_spacing(points, pdf);
     eprintln!(
-        "tessera: {} points: separation {:.4}, covering radius x sqrt(N) {:.4}, mesh ratio {:.4}",
+        "tessera: {} points, angles x sqrt(4 pi N pdf) (sqrt(N) for a uniform request): \
+         separation {:.4}, covering radius {:.4}, mesh ratio {:.4}",
         points.len(),
-        separation(points),
-        covering_radius(points),
-        mesh_ratio(points)
+        local.separation,
+        local.covering_radius,
+        local.mesh_ratio
     );
-}
-
-impl From<UpAxis> for tessera::density::envmap::Up {
-    fn from(up: UpAxis) -> Self {
-        match up {
-            UpAxis::Z => tessera::density::envmap::Up::Z,
-            UpAxis::Y => tessera::density::envmap::Up::Y,
-        }
-    }
 }
