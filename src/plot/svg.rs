@@ -149,7 +149,10 @@ pub fn plane_tiles(
 /// Draws the Penrose tiles of a level that reach the unit square (x to the
 /// right, y down), triangles filled by code rank (dark = kept first) and
 /// clipped to the square, each point tile's code beside its vertex when
-/// there are at most 400 of them, and the given points as dots.
+/// there are at most 400 of them and a legible font (4 px or more) fits
+/// between the closest vertices (a short diagonal, 0.38 edges apart, holds
+/// the widest code at 0.6 font sizes a digit; level 8's labels overlapped
+/// when the font was 0.3 edges), and the given points as dots.
 ///
 /// # Example
 /// ```
@@ -185,8 +188,9 @@ pub fn penrose_tiles(
         );
     }
     let vertices: Vec<_> = tiles.iter().filter(|t| t.kind.is_point()).collect();
-    if vertices.len() <= 400 {
-        let font = (edge * 0.3).max(4.0);
+    let digits = (capacity.max(10.0)).log10().ceil();
+    let font = 0.38 * edge / (0.6 * digits);
+    if vertices.len() <= 400 && font >= 4.0 {
         for t in vertices {
             let _ = writeln!(
                 svg,
