@@ -151,7 +151,8 @@ impl SphereRequest {
     /// ```
     /// use tessera::{lut::{penrose_lut, Table}, request::SphereRequest};
     /// let request = SphereRequest { table: Some(Table::Penrose(penrose_lut())), ..Default::default() };
-    /// assert!(request.tiling().unwrap_err().to_string().contains("not a sphere table"));
+    /// let refused = request.tiling().err().expect("a Penrose table is refused");
+    /// assert!(refused.to_string().contains("not a sphere table"));
     /// ```
     pub fn tiling(&self) -> Result<SphereTiling, Error> {
         match &self.table {

@@ -61,7 +61,7 @@ fn tiny_accuracy_bench_fits_iid_slope_and_writes_its_files() {
         .iter()
         .filter(|f| f.extension().is_some_and(|e| e == "png"))
     {
-        assert_eq!(image::open(png).unwrap().width(), 640);
+        assert_eq!(image::open(png).unwrap().width(), 840);
     }
     let md = std::fs::read_to_string(dir.join("ACCURACY.md")).unwrap();
     for needle in [
