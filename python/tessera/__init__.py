@@ -541,7 +541,7 @@ def stream(n, chunk=1 << 20):
     """Uniform sphere samples in chunks of at most ``chunk`` rows, in bounded memory.
 
     The n samples of ``sphere(n)``, in the same order (the library computes
-    uniform samples one at a time from their codes, with O(depth) state),
+    uniform samples from their codes a block at a time, in bounded memory),
     yielded as (k, 3) arrays: a billion points never need to be held at
     once. Each chunk is computed without the GIL, on one thread.
 
