@@ -1,4 +1,4 @@
-//! Streams N uniform sphere samples one at a time (O(depth) memory) and
+//! Streams N uniform sphere samples (a block of codes at a time, bounded memory) and
 //! prints their mean position. `/usr/bin/time -v` shows the peak RSS.
 //! Run: `cargo run --release --example stream -- 1000000000`.
 

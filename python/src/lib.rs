@@ -761,8 +761,8 @@ fn tiling() -> &'static SphereTiling {
     TILING.get_or_init(SphereTiling::default)
 }
 
-/// See `tessera.stream`: uniform sphere samples in chunks, computed one
-/// at a time from their codes (`tessera::engine::stream`).
+/// See `tessera.stream`: uniform sphere samples in chunks, computed from
+/// their codes a block at a time (`tessera::engine::stream`).
 #[pyclass(module = "tessera._tessera")]
 struct Stream {
     inner: tessera::engine::Stream<'static, SphereTiling>,
