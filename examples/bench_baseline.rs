@@ -1,5 +1,8 @@
 //! The Rust side of `python/bench.py`: runs the library calls that the
-//! Python package's functions stand for, one per request name read from
+//! Python package's functions make (`SphereRequest::points` and
+//! `PlaneRequest::points`, which return positions as the Python functions
+//! do, and cost what `Sampler::generate` does within noise), one per
+//! request name read from
 //! standard input, and answers each with `WALL CPU` (seconds of wall-clock
 //! and of this process's CPU time, all threads), so that the bench can
 //! alternate Rust and Python calls one by one under the same machine load.
@@ -10,9 +13,7 @@
 use std::io::{BufRead, Write};
 use std::time::Instant;
 use tessera::density::envmap::{EnvMap, Up};
-use tessera::density::sphere::Cap;
-use tessera::tiling::plane::PlaneTiling;
-use tessera::Sampler;
+use tessera::request::{PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
 
 /// This process's CPU time (all threads), in seconds.
 #[cfg(target_os = "linux")]
@@ -48,10 +49,16 @@ fn main() -> Result<(), tessera::Error> {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1_000_000);
     let path = args.next().unwrap_or_else(|| "sky.exr".into());
-    let cap = Cap::new(10.0, 20.0, 30.0, 10.0)?;
-    let ghexomino = Sampler::new(PlaneTiling::ghexomino()).count(n);
+    let uniform = SphereDensity::parse(&["uniform"])?;
+    let cap = SphereDensity::parse(&["cap:10,20,30,10"])?;
+    let ghexomino = tessera::density::plane::parse("uniform", false)?;
+    let sphere = SphereRequest {
+        count: n,
+        ..Default::default()
+    };
+    let plane = PlaneRequest::new(PlaneKind::Ghexomino, n);
     // a map built once and sampled again and again (`tessera.Map`)
-    let map = EnvMap::open(path.as_ref(), &Default::default(), Up::Z)?;
+    let map = SphereDensity::Map(EnvMap::open(path.as_ref(), &Default::default(), Up::Z)?);
     // its pixels, to build a map from for each request (an array passed
     // to `tessera.sphere`)
     let raster = tessera::io::image::read_raster(path.as_ref(), &Default::default())?;
@@ -62,11 +69,14 @@ fn main() -> Result<(), tessera::Error> {
             source,
         })?;
         let (wall, cpu) = match line.trim() {
-            "sphere_uniform" => time(|| Sampler::sphere().count(n).generate()),
-            "sphere_cap" => time(|| Sampler::sphere().density(cap).count(n).generate()),
-            "plane_ghexomino" => time(|| ghexomino.generate()),
-            "sphere_map" => time(|| map.generate(n)),
-            "sphere_map_array" => time(|| EnvMap::new(raster.clone(), Up::Z)?.generate(n)),
+            "sphere_uniform" => time(|| sphere.points(&uniform)),
+            "sphere_cap" => time(|| sphere.points(&cap)),
+            "plane_ghexomino" => time(|| plane.points(&*ghexomino)),
+            "sphere_map" => time(|| sphere.points(&map)),
+            "sphere_map_array" => time(|| {
+                let map = EnvMap::new(raster.clone(), Up::Z)?;
+                sphere.points(&SphereDensity::Map(map))
+            }),
             other => {
                 eprintln!("unknown request '{other}'");
                 std::process::exit(2);

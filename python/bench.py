@@ -25,6 +25,12 @@ import tempfile
 import time
 from pathlib import Path
 
+# numpy's OpenBLAS starts worker threads at import that spin on a core now
+# and then (`blas_thread_server` in a profile of this script, 2.5 % of its
+# CPU time), though nothing here calls BLAS: they would be counted as the
+# package's overhead. One BLAS thread starts none.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 # the installed package, not its sources beside this script

@@ -23,6 +23,7 @@ use tessera::engine::Order;
 use tessera::healpix::Scheme;
 use tessera::io::image::{Raster, ReadOptions};
 use tessera::lights::RgbMap;
+use tessera::lut::{Table, TableSystem};
 use tessera::request::{MapWarning, PlaneKind, PlaneRequest, SphereDensity, SphereRequest};
 use tessera::tiling::sphere::SphereTiling;
 use tessera::Error;
@@ -222,45 +223,25 @@ impl MapArray {
     }
 }
 
-/// Where a sphere map comes from.
+/// Where a lat-long map comes from.
 enum MapSource {
     Path(PathBuf),
     Array(MapArray),
-    /// A map read once (`tessera.Map`), reused.
-    Ready(EnvMap),
 }
 
 fn map_source(
     path: Option<PathBuf>,
     array: Option<PyReadonlyArrayDyn<'_, f64>>,
-    ready: Option<PyRef<'_, Map>>,
-) -> PyResult<Option<MapSource>> {
-    match (path, array, ready) {
-        (Some(path), None, None) => Ok(Some(MapSource::Path(path))),
-        (None, Some(array), None) => Ok(Some(MapSource::Array(MapArray::copy(&array)?))),
-        (None, None, Some(map)) => Ok(Some(MapSource::Ready(map.map.clone()))),
-        (None, None, None) => Ok(None),
-        _ => Err(PyValueError::new_err(
-            "a map is a path, an array or a tessera.Map, one of them",
-        )),
+) -> PyResult<MapSource> {
+    match (path, array) {
+        (Some(path), None) => Ok(MapSource::Path(path)),
+        (None, Some(array)) => Ok(MapSource::Array(MapArray::copy(&array)?)),
+        _ => Err(PyValueError::new_err("a map is a path or an array, one of them")),
     }
 }
 
 /// The name errors and warnings give a HEALPix map passed as an array.
 const HEALPIX_ARRAY: &str = "healpix array";
-
-/// A HEALPix map passed as an array, copied out of Python.
-struct HealpixArray {
-    values: Vec<f64>,
-    scheme: Scheme,
-}
-
-fn healpix_array(array: Option<PyReadonlyArray1<'_, f64>>, nest: bool) -> Option<HealpixArray> {
-    array.map(|a| HealpixArray {
-        values: a.as_array().to_vec(),
-        scheme: if nest { Scheme::Nested } else { Scheme::Ring },
-    })
-}
 
 /// How warnings name the strict option.
 const STRICT: &str = "strict=True";
@@ -269,33 +250,24 @@ fn messages(warnings: impl IntoIterator<Item = MapWarning>) -> Warnings {
     warnings.into_iter().map(|w| w.message(STRICT)).collect()
 }
 
-/// The density of a sphere request and the warnings its map deserves.
-fn sphere_density(
-    density: &[String],
-    map: Option<&MapSource>,
-    healpix: Option<HealpixArray>,
+/// A lat-long map read from its source, with the warnings it deserves.
+fn read_map(
+    source: &MapSource,
     up: Up,
     channel: Option<String>,
     strict: bool,
-) -> Result<(SphereDensity, Warnings), Error> {
-    if let Some(HealpixArray { values, scheme }) = healpix {
-        let map = HealpixMap::new(HEALPIX_ARRAY, values, scheme, strict)?;
-        let warnings = tessera::request::healpix_warnings(HEALPIX_ARRAY.as_ref(), &map);
-        return Ok((SphereDensity::Healpix(map), messages(warnings)));
-    }
-    match map {
-        None => Ok((SphereDensity::parse(density)?, Vec::new())),
-        Some(MapSource::Ready(map)) => Ok((SphereDensity::Map(map.clone()), Vec::new())),
-        Some(MapSource::Path(path)) => {
+) -> Result<(EnvMap, Warnings), Error> {
+    match source {
+        MapSource::Path(path) => {
             let options = ReadOptions {
                 channel,
                 strict,
                 ..Default::default()
             };
             let (map, warnings) = tessera::request::open_map(path, &options, up)?;
-            Ok((SphereDensity::Map(map), messages(warnings)))
+            Ok((map, messages(warnings)))
         }
-        Some(MapSource::Array(array)) => {
+        MapSource::Array(array) => {
             if channel.is_some() {
                 return Err(Error::Request(
                     "channel picks a channel of a map file; of an array, pass the plane you want (e.g. map[..., 0])".into(),
@@ -312,9 +284,21 @@ fn sphere_density(
             }
             let (map, more) = tessera::request::map_from_raster(MAP_ARRAY.as_ref(), raster, up)?;
             warnings.extend(more);
-            let warnings = messages(warnings);
-            Ok((SphereDensity::Map(map), warnings))
+            Ok((map, messages(warnings)))
         }
+    }
+}
+
+/// The density of a sphere request: a prepared map, or the regions.
+fn sphere_density(
+    density: &[String],
+    map: Option<&Map>,
+    healpix: Option<&Healpix>,
+) -> Result<SphereDensity, Error> {
+    match (map, healpix) {
+        (Some(map), _) => Ok(SphereDensity::Map(map.map.clone())),
+        (None, Some(healpix)) => Ok(SphereDensity::Healpix(healpix.map.clone())),
+        (None, None) => SphereDensity::parse(density),
     }
 }
 
@@ -349,6 +333,8 @@ fn rows<const K: usize>(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<[f64;
 }
 
 type Warnings = Vec<String>;
+/// Points and their pdfs when asked for.
+type Points<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray1<f64>>>);
 /// Points, their pdfs when asked for, and warnings.
 type PointsOut<'py> = (
     Bound<'py, PyArray2<f64>>,
@@ -360,20 +346,14 @@ type Columns<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// See `tessera.sphere`.
 #[pyfunction]
-#[pyo3(signature = (n, density, map_path, map_array, map_ready, healpix, nest, up, channel, strict, within, seed, threads, expected, unsorted, pdf, relax))]
+#[pyo3(signature = (n, density, map, healpix, within, seed, threads, expected, unsorted, pdf, relax, table))]
 #[allow(clippy::too_many_arguments)]
 fn sphere<'py>(
     py: Python<'py>,
     n: usize,
     density: Vec<String>,
-    map_path: Option<PathBuf>,
-    map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
-    map_ready: Option<PyRef<'py, Map>>,
-    healpix: Option<PyReadonlyArray1<'py, f64>>,
-    nest: bool,
-    up: &str,
-    channel: Option<String>,
-    strict: bool,
+    map: Option<PyRef<'py, Map>>,
+    healpix: Option<PyRef<'py, Healpix>>,
     within: Option<String>,
     seed: Option<u64>,
     threads: Option<usize>,
@@ -381,13 +361,11 @@ fn sphere<'py>(
     unsorted: bool,
     pdf: bool,
     relax: usize,
-) -> PyResult<PointsOut<'py>> {
-    let up = up_axis(up)?;
-    let map = map_source(map_path, map_array, map_ready)?;
-    let healpix = healpix_array(healpix, nest);
-    let (points, pdfs, warnings) = run(py, threads, move || {
-        let (density, warnings) =
-            sphere_density(&density, map.as_ref(), healpix, up, channel, strict)?;
+    table: Option<PathBuf>,
+) -> PyResult<Points<'py>> {
+    let density = sphere_density(&density, map.as_deref(), healpix.as_deref())
+        .map_err(Failure::from)?;
+    let (points, pdfs) = run(py, threads, move || {
         let request = SphereRequest {
             count: n,
             expected,
@@ -395,39 +373,34 @@ fn sphere<'py>(
             seed,
             within: within.as_deref().map(Cap::window).transpose()?,
             relax,
-            table: None,
+            table: table
+                .map(|path| Table::open(&path, TableSystem::Sphere))
+                .transpose()?,
         };
         let points = request.points(&density)?;
         let pdfs = pdf.then(|| {
             let pdf = density.pdf();
             points.par_iter().map(|&p| pdf(p)).collect::<Vec<f64>>()
         });
-        Ok((points, pdfs, warnings))
+        Ok((points, pdfs))
     })?;
     let pdfs = pdfs.map(|p| PyArray1::from_vec(py, p));
-    Ok((points3(py, points)?, pdfs, warnings))
+    Ok((points3(py, points)?, pdfs))
 }
 
 /// See `tessera.pdf`.
 #[pyfunction]
-#[pyo3(signature = (directions, density, map_path, map_array, map_ready, healpix, nest, up, channel, strict, threads))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (directions, density, map, healpix, threads))]
 fn pdf<'py>(
     py: Python<'py>,
     directions: PyReadonlyArray2<'py, f64>,
     density: Vec<String>,
-    map_path: Option<PathBuf>,
-    map_array: Option<PyReadonlyArrayDyn<'py, f64>>,
-    map_ready: Option<PyRef<'py, Map>>,
-    healpix: Option<PyReadonlyArray1<'py, f64>>,
-    nest: bool,
-    up: &str,
-    channel: Option<String>,
-    strict: bool,
+    map: Option<PyRef<'py, Map>>,
+    healpix: Option<PyRef<'py, Healpix>>,
     threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Warnings)> {
-    let up = up_axis(up)?;
-    let map = map_source(map_path, map_array, map_ready)?;
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let density = sphere_density(&density, map.as_deref(), healpix.as_deref())
+        .map_err(Failure::from)?;
     let directions: Vec<DVec3> = rows::<3>(&directions)?
         .into_iter()
         .map(DVec3::from_array)
@@ -441,20 +414,16 @@ fn pdf<'py>(
             directions[k]
         )));
     }
-    let healpix = healpix_array(healpix, nest);
-    let (pdfs, warnings) = run(py, threads, move || {
-        let (density, warnings) =
-            sphere_density(&density, map.as_ref(), healpix, up, channel, strict)?;
+    let pdfs = run(py, threads, move || {
         let pdf = density.pdf();
-        let pdfs: Vec<f64> = directions.par_iter().map(|&d| pdf(d)).collect();
-        Ok((pdfs, warnings))
+        Ok(directions.par_iter().map(|&d| pdf(d)).collect())
     })?;
-    Ok((PyArray1::from_vec(py, pdfs), warnings))
+    Ok(PyArray1::from_vec(py, pdfs))
 }
 
 /// See `tessera.plane`.
 #[pyfunction]
-#[pyo3(signature = (n, system, density, image_path, image_array, invert, domain, seed, threads, expected, unsorted, pdf))]
+#[pyo3(signature = (n, system, density, image_path, image_array, invert, domain, seed, threads, expected, unsorted, pdf, table))]
 #[allow(clippy::too_many_arguments)]
 fn plane<'py>(
     py: Python<'py>,
@@ -470,6 +439,7 @@ fn plane<'py>(
     expected: bool,
     unsorted: bool,
     pdf: bool,
+    table: Option<PathBuf>,
 ) -> PyResult<PointsOut<'py>> {
     let image = match image_array {
         Some(array) => Some(MapArray::copy(&array)?),
@@ -509,7 +479,9 @@ fn plane<'py>(
                 .as_deref()
                 .map(tessera::density::rectangle::Rectangle::parse)
                 .transpose()?,
-            table: None,
+            table: table
+                .map(|path| Table::open(&path, system.table_system()))
+                .transpose()?,
         };
         let points = request.points(&*density)?;
         let pdfs = pdf.then(|| {
@@ -548,8 +520,7 @@ fn lights<'py>(
     threads: Option<usize>,
 ) -> PyResult<LightsOut<'py>> {
     let up = up_axis(up)?;
-    let map = map_source(map_path, map_array, None)?
-        .ok_or_else(|| PyValueError::new_err("lights need a map (a path or an array)"))?;
+    let map = map_source(map_path, map_array)?;
     let (lights, warnings) = run(py, threads, move || {
         let (map, rgb, warnings): (EnvMap, RgbMap, Warnings) = match &map {
             MapSource::Path(path) => {
@@ -583,7 +554,6 @@ fn lights<'py>(
                 warnings.extend(more);
                 (map, rgb, messages(warnings))
             }
-            MapSource::Ready(_) => unreachable!("lights read their map themselves"),
         };
         let options = tessera::lights::LightOptions {
             rgb: Some(&rgb),
@@ -744,14 +714,63 @@ fn open_map<'py>(
     strict: bool,
 ) -> PyResult<(Map, Warnings)> {
     let up = up_axis(up)?;
-    let source = map_source(map_path, map_array, None)?
-        .ok_or_else(|| PyValueError::new_err("a map is a path or an array"))?;
+    let source = map_source(map_path, map_array)?;
     run(py, None, move || {
-        let (density, warnings) = sphere_density(&[], Some(&source), None, up, channel, strict)?;
-        match density {
-            SphereDensity::Map(map) => Ok((Map { map }, warnings)),
-            _ => unreachable!("a map source gives a map"),
-        }
+        let (map, warnings) = read_map(&source, up, channel, strict)?;
+        Ok((Map { map }, warnings))
+    })
+}
+
+/// A HEALPix map read once, to sample and to give pdfs again and again
+/// (`tessera.HealpixMap`): its max pyramid is kept.
+#[pyclass(module = "tessera._tessera", frozen)]
+struct Healpix {
+    map: HealpixMap,
+}
+
+#[pymethods]
+impl Healpix {
+    /// The map's nside.
+    #[getter]
+    fn nside(&self) -> u64 {
+        self.map.nside()
+    }
+
+    /// The file's COORDSYS (e.g. "G", "C"), when it has one.
+    #[getter]
+    fn coordsys(&self) -> Option<String> {
+        self.map.coordsys().map(str::to_string)
+    }
+}
+
+/// See `tessera.HealpixMap`.
+#[pyfunction]
+#[pyo3(signature = (path, array, nest, field, strict))]
+fn open_healpix<'py>(
+    py: Python<'py>,
+    path: Option<PathBuf>,
+    array: Option<PyReadonlyArray1<'py, f64>>,
+    nest: bool,
+    field: usize,
+    strict: bool,
+) -> PyResult<(Healpix, Warnings)> {
+    let values = array.map(|a| a.as_array().to_vec());
+    let scheme = if nest { Scheme::Nested } else { Scheme::Ring };
+    run(py, None, move || {
+        let (map, warnings) = match (path, values) {
+            (Some(path), None) => tessera::request::open_healpix(&path, field, strict)?,
+            (None, Some(values)) => {
+                let map = HealpixMap::new(HEALPIX_ARRAY, values, scheme, strict)?;
+                let warnings = tessera::request::healpix_warnings(HEALPIX_ARRAY.as_ref(), &map);
+                (map, warnings)
+            }
+            _ => {
+                return Err(Error::Request(
+                    "a HEALPix map is a path or an array, one of them".into(),
+                ))
+            }
+        };
+        Ok((Healpix { map }, messages(warnings)))
     })
 }
 
@@ -814,8 +833,10 @@ fn _tessera(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_lonlat, m)?)?;
     m.add_function(wrap_pyfunction!(metrics, m)?)?;
     m.add_function(wrap_pyfunction!(open_map, m)?)?;
+    m.add_function(wrap_pyfunction!(open_healpix, m)?)?;
     m.add_class::<Stream>()?;
     m.add_class::<Map>()?;
+    m.add_class::<Healpix>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("PAIRS_UP_TO", tessera::metrics::PAIRS_UP_TO)?;
     Ok(())

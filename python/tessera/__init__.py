@@ -31,6 +31,7 @@ from . import metrics
 
 __all__ = [
     "Map",
+    "HealpixMap",
     "sphere",
     "pdf",
     "plane",
@@ -89,12 +90,19 @@ def _densities(density):
     return specs
 
 
+def _path(path):
+    """A path as a string, or None."""
+    return None if path is None else os.fsdecode(path)
+
+
 def _map(map, name="map"):
     """(path, array, prepared map) of a map given as a path, an array or a Map."""
     if map is None:
         return None, None, None
     if isinstance(map, Map):
         return None, None, map._native
+    if isinstance(map, HealpixMap):
+        raise TypeError(f"a {name} is a lat-long map or image; a tessera.HealpixMap goes to healpix=")
     if isinstance(map, (str, bytes, os.PathLike)):
         return os.fsdecode(map), None, None
     array = np.ascontiguousarray(map, dtype=np.float64)
@@ -108,34 +116,58 @@ def _warn(messages):
         _warnings.warn(message, RuntimeWarning, stacklevel=3)
 
 
-def _healpix(healpix, nest):
-    """A HEALPix map as a float64 vector, or None."""
-    if healpix is None:
-        if nest:
-            raise ValueError("nest applies to a HEALPix map (healpix=...)")
-        return None
+def _healpix_array(healpix):
+    """A HEALPix map given as values, as a float64 vector."""
     array = np.ascontiguousarray(healpix, dtype=np.float64)
     if array.ndim != 1:
         raise ValueError(f"a healpix map is a vector of 12 nside**2 values; this one has shape {array.shape}")
     return array
 
 
-def _sphere_density(density, map, up, channel, strict, healpix=None, nest=False):
-    healpix = _healpix(healpix, nest)
+def _open_healpix(healpix, nest, field, strict):
+    """(native HEALPix map, warnings) of a FITS path or an array."""
+    if isinstance(healpix, (str, bytes, os.PathLike)):
+        if nest:
+            raise ValueError("nest applies to a HEALPix array; a FITS file declares its ORDERING")
+        field = 0 if field is None else _count(field, "field")
+        return _tessera.open_healpix(os.fsdecode(healpix), None, False, field, bool(strict))
+    if field is not None:
+        raise ValueError("field picks a column of a HEALPix FITS file, not of an array")
+    return _tessera.open_healpix(None, _healpix_array(healpix), bool(nest), 0, bool(strict))
+
+
+def _sphere_density(density, map, up, channel, strict, healpix, nest, field):
+    """(region strings, native map, native HEALPix map, warnings) of the
+    density options of ``sphere`` and ``pdf``: a map given as a path or an
+    array is read here, as ``Map`` and ``HealpixMap`` read it."""
     if healpix is not None:
         if map is not None or density != "uniform":
             raise ValueError("a healpix map replaces the density: pass one of density=, map= and healpix=")
         if channel is not None or up != "z":
             raise ValueError("up and channel apply to a lat-long map (map=...), not to healpix=")
-    elif map is None:
+        if isinstance(healpix, HealpixMap):
+            if nest or strict or field is not None:
+                raise ValueError(
+                    "a tessera.HealpixMap was read with its nest, field and strict: give them to HealpixMap()"
+                )
+            return [], None, healpix._native, []
+        native, notes = _open_healpix(healpix, nest, field, strict)
+        return [], None, native, notes
+    if nest or field is not None:
+        raise ValueError("nest and field apply to a HEALPix map (healpix=...)")
+    if map is None:
         if channel is not None or strict or up != "z":
             raise ValueError("up, channel and strict apply to a map (map=... or healpix=...)")
-    elif density != "uniform":
+        return _densities(density), None, None, []
+    if density != "uniform":
         raise ValueError("a map replaces the density: pass map= or density=, not both")
-    elif isinstance(map, Map) and (channel is not None or strict or up != "z"):
-        raise ValueError("a tessera.Map was read with its up, channel and strict: give them to Map()")
-    map_path, map_array, map_ready = _map(map)
-    return _densities(density), map_path, map_array, map_ready, healpix
+    if isinstance(map, Map):
+        if channel is not None or strict or up != "z":
+            raise ValueError("a tessera.Map was read with its up, channel and strict: give them to Map()")
+        return [], map._native, None, []
+    path, array, _ = _map(map)
+    native, notes = _tessera.open_map(path, array, up, channel, bool(strict))
+    return [], native, None, notes
 
 
 class Map:
@@ -185,6 +217,51 @@ class Map:
         return f"tessera.Map({self.width}x{self.height}, integral {self.integral:g})"
 
 
+class HealpixMap:
+    """A HEALPix map read once, for many ``sphere`` and ``pdf`` calls.
+
+    ``sphere(n, healpix=values_or_path)`` reads the map and builds the
+    bounds sampling needs on every call; a ``HealpixMap`` is read once and
+    keeps them. ``map`` is a vector of 12 nside**2 values (RING order
+    unless ``nest``; a healpy map) or the path of a HEALPix FITS file
+    (healpy's binary table, whose ORDERING header gives the order;
+    ``field`` picks its column, 0 by default). ``strict`` refuses NaN,
+    infinite and negative pixels; otherwise they count as 0, as UNSEEN
+    pixels do, with a warning given here.
+
+    Attributes: ``nside``, and ``coordsys`` (the file's COORDSYS, or
+    None).
+
+    Examples
+    --------
+    >>> import numpy as np, tessera
+    >>> hot = np.ones(768); hot[300] = 1000.0  # nside 8, RING
+    >>> sky = tessera.HealpixMap(hot)
+    >>> sky.nside
+    8
+    >>> points = tessera.sphere(2000, healpix=sky)
+    >>> bool((tessera.sphere(2000, healpix=hot) == points).all())
+    True
+    """
+
+    def __init__(self, map, *, nest=False, field=None, strict=False):
+        if isinstance(map, HealpixMap):
+            raise TypeError("map is already a tessera.HealpixMap")
+        self._native, notes = _open_healpix(map, nest, field, strict)
+        _warn(notes)
+
+    @property
+    def nside(self):
+        return self._native.nside
+
+    @property
+    def coordsys(self):
+        return self._native.coordsys
+
+    def __repr__(self):
+        return f"tessera.HealpixMap(nside {self.nside})"
+
+
 def sphere(
     n,
     density="uniform",
@@ -192,6 +269,7 @@ def sphere(
     map=None,
     healpix=None,
     nest=False,
+    field=None,
     up="z",
     channel=None,
     strict=False,
@@ -202,6 +280,7 @@ def sphere(
     unsorted=False,
     pdf=False,
     relax=0,
+    table=None,
 ):
     """Samples of the unit sphere: an (n, 3) float64 array of unit vectors.
 
@@ -226,15 +305,20 @@ def sphere(
         Row 0 is at +Z (theta = 0); column i covers phi = atan2(y, x) in
         [2 pi i / W, 2 pi (i + 1) / W). Constant per pixel per unit solid
         angle.
-    healpix : array, optional
+    healpix : array, path or HealpixMap, optional
         Importance from a HEALPix map instead of ``density``: a vector of
         12 nside**2 values (nside a power of two; a healpy map), RING
-        order unless ``nest``. Constant per pixel per unit solid angle, in
+        order unless ``nest``; a HEALPix FITS file (its ORDERING header
+        gives the order); or a ``tessera.HealpixMap`` read once for many
+        calls. Constant per pixel per unit solid angle, in
         the map's frame (theta from +Z, phi = atan2(y, x), as
         ``healpy.ang2pix``). UNSEEN pixels count as 0 with a warning, as
         do NaN, infinite and negative ones (``strict`` refuses those).
     nest : bool
-        The ``healpix`` map is in NESTED order.
+        The ``healpix`` array is in NESTED order.
+    field : int, optional
+        The column of a ``healpix`` FITS file to read (default 0), as
+        ``tessera sphere --field``.
     up : {"z", "y"}
         The map's up axis; with "y" a direction (x, y, z) is looked up as
         (z, x, y).
@@ -266,6 +350,9 @@ def sphere(
         Density-weighted Lloyd iterations run on the set: more even
         spacing, but prefixes are no longer progressive and the pdf is the
         target density's.
+    table : path, optional
+        Sample with this sphere table (written by ``tessera lut build``)
+        instead of the built-in one, as ``tessera sphere --table``.
 
     Returns
     -------
@@ -289,20 +376,15 @@ def sphere(
     True
     """
     n = _count(n)
-    specs, map_path, map_array, map_ready, healpix = _sphere_density(
-        density, map, up, channel, strict, healpix, nest
+    specs, native_map, native_healpix, notes = _sphere_density(
+        density, map, up, channel, strict, healpix, nest, field
     )
-    points, pdfs, notes = _tessera.sphere(
+    _warn(notes)
+    points, pdfs = _tessera.sphere(
         n,
         specs,
-        map_path,
-        map_array,
-        map_ready,
-        healpix,
-        bool(nest),
-        up,
-        channel,
-        bool(strict),
+        native_map,
+        native_healpix,
         _spec(within, 3, "within"),
         _seed(seed),
         _threads(threads),
@@ -310,8 +392,8 @@ def sphere(
         bool(unsorted),
         bool(pdf),
         _count(relax, "relax"),
+        _path(table),
     )
-    _warn(notes)
     return (points, pdfs) if pdf else points
 
 
@@ -322,6 +404,7 @@ def pdf(
     map=None,
     healpix=None,
     nest=False,
+    field=None,
     up="z",
     channel=None,
     strict=False,
@@ -331,11 +414,11 @@ def pdf(
     """The pdf per steradian that ``sphere`` samples follow, at any directions.
 
     For multiple importance sampling: the same density options as
-    ``sphere`` (``density``, ``map``, ``healpix``, ``nest``, ``up``,
-    ``channel``, ``strict``); in a
-    render loop pass a ``tessera.Map``, read once.
+    ``sphere`` (``density``, ``map``, ``healpix``, ``nest``, ``field``,
+    ``up``, ``channel``, ``strict``); in a render loop pass a
+    ``tessera.Map`` (or ``tessera.HealpixMap``), read once.
     ``sphere``'s other options (``within``, ``seed``, ``expected``,
-    ``unsorted``, ``relax``, ``n``) are accepted and do not change the pdf,
+    ``unsorted``, ``relax``, ``table``, ``n``) are accepted and do not change the pdf,
     as in ``tessera sphere --format csv``. Directions (an (n, 3) or (3,)
     array) need not be normalised.
 
@@ -348,7 +431,7 @@ def pdf(
     >>> bool((tessera.pdf(points, "cap:10,20,30,8") == p).all())
     True
     """
-    unknown = set(request) - {"n", "within", "seed", "expected", "unsorted", "relax", "pdf"}
+    unknown = set(request) - {"n", "within", "seed", "expected", "unsorted", "relax", "pdf", "table"}
     if unknown:
         raise TypeError(f"pdf() got unexpected keyword argument(s): {', '.join(sorted(unknown))}")
     directions = np.ascontiguousarray(directions, dtype=np.float64)
@@ -356,13 +439,11 @@ def pdf(
     rows = directions.reshape(1, -1) if single else directions
     if rows.ndim != 2 or rows.shape[1] != 3:
         raise ValueError(f"directions are an (n, 3) array; this one has shape {directions.shape}")
-    specs, map_path, map_array, map_ready, healpix = _sphere_density(
-        density, map, up, channel, strict, healpix, nest
-    )
-    values, notes = _tessera.pdf(
-        rows, specs, map_path, map_array, map_ready, healpix, bool(nest), up, channel, bool(strict), _threads(threads)
+    specs, native_map, native_healpix, notes = _sphere_density(
+        density, map, up, channel, strict, healpix, nest, field
     )
     _warn(notes)
+    values = _tessera.pdf(rows, specs, native_map, native_healpix, _threads(threads))
     return values[0] if single else values
 
 
@@ -379,6 +460,7 @@ def plane(
     expected=False,
     unsorted=False,
     pdf=False,
+    table=None,
 ):
     """Samples of the unit square (or a rectangle): an (n, 2) float64 array.
 
@@ -408,6 +490,9 @@ def plane(
     threads, expected, unsorted : as for ``sphere``.
     pdf : bool
         Also return the pdf per unit area of the domain of each sample.
+    table : path, optional
+        Sample with this table of ``system`` (written by ``tessera lut
+        build``) instead of the built-in one, as ``tessera plane --table``.
 
     Examples
     --------
@@ -437,6 +522,7 @@ def plane(
         bool(expected),
         bool(unsorted),
         bool(pdf),
+        _path(table),
     )
     _warn(notes)
     return (points, pdfs) if pdf else points

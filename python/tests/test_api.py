@@ -188,6 +188,12 @@ def test_bad_requests_raise_value_error_with_the_library_message(tmp_path):
         (lambda: tessera.sphere(10, map=tessera.Map(np.ones((4, 8))), up="y"), "give them to Map()"),
         (lambda: tessera.Map(np.zeros((4, 8))), "nothing to sample"),
         (lambda: tessera.stream(10**30), "must be in"),
+        (lambda: tessera.sphere(10, healpix=np.ones(768), field=1), "field picks a column"),
+        (lambda: tessera.sphere(10, healpix="m.fits", nest=True), "declares its ORDERING"),
+        (lambda: tessera.sphere(10, nest=True), "apply to a HEALPix map"),
+        (lambda: tessera.sphere(10, healpix=tessera.HealpixMap(np.ones(48)), nest=True), "give them to HealpixMap()"),
+        (lambda: tessera.HealpixMap(np.ones(50)), "12 nside^2"),
+        (lambda: tessera.HealpixMap(np.ones((12, 4))), "vector of 12 nside**2"),
     ]
     for call, message in cases:
         with pytest.raises(ValueError) as raised:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tessera
-from conftest import read_csv, read_utk
+from conftest import REPO, read_csv, read_utk
 from maps import write_exr, write_healpix, write_png
 
 
@@ -132,11 +132,33 @@ def test_healpix_maps_are_the_cli_healpix_maps(cli, tmp_path):
             same(pdf, rows[:, 5])
             with pytest.warns(RuntimeWarning, match="UNSEEN"):
                 same(tessera.pdf(points, healpix=values.astype(np.float64), **ordering), pdf)
+            # the file itself, and maps read once from the file and the array
+            with pytest.warns(RuntimeWarning, match="2 UNSEEN pixel"):
+                same(tessera.sphere(4000, healpix=path, **options), points)
+            with pytest.warns(RuntimeWarning, match="2 UNSEEN pixel"):
+                prepared = [tessera.HealpixMap(path), tessera.HealpixMap(values, **ordering)]
+            for read_once in prepared:
+                assert read_once.nside == 16
+                same(tessera.sphere(4000, healpix=read_once, **options), points)
+                same(tessera.pdf(points, healpix=read_once), pdf)
     # nside 8 in float64, one value a row
     values = 1.0 + rng.random(768)
     write_healpix(tmp_path / "d.fits", values, nest=True, dtype=">f8")
     expected = read_utk(cli("sphere", "-n", 1500, "--healpix-map", tmp_path / "d.fits", "--format", "bin"))
     same(tessera.sphere(1500, healpix=values, nest=True), expected)
+
+
+def test_tables_read_at_run_time_are_the_cli_tables(cli, tmp_path):
+    table = REPO / "luts" / "ppentomino.lut"
+    expected = read_utk(cli("plane", "--system", "ppentomino", "-n", 2000, "--table", table, "--format", "bin"))
+    same(tessera.plane(2000, "ppentomino", table=table), expected)
+    # the shipped table is the built-in one
+    same(tessera.plane(2000, "ppentomino", table=str(table)), tessera.plane(2000, "ppentomino"))
+    for wrong in (lambda: tessera.sphere(10, table=table), lambda: tessera.plane(10, "ghexomino", table=table)):
+        with pytest.raises(ValueError, match="ppentomino.lut: not a"):
+            wrong()
+    with pytest.raises(FileNotFoundError, match="missing.lut"):
+        tessera.sphere(10, table=tmp_path / "missing.lut")
 
 
 def test_png_map_is_the_cli_png_map(cli, tmp_path):
