@@ -46,6 +46,11 @@ def test_files_healpy_writes_are_read_as_healpy_reads_them(cli, tmp_path, nest):
             points = tessera.sphere(3000, healpix=read, nest=nest)
         assert any("2 UNSEEN pixel(s)" in str(w.message) for w in caught) == (field == 1)
         assert points.tobytes() == expected.tobytes()
+        # the file itself, read by tessera
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert tessera.sphere(3000, healpix=path, field=field).tobytes() == expected.tobytes()
+            assert tessera.HealpixMap(path, field=field).coordsys == "G"
         pixels = hp.vec2pix(nside, *points.T, nest=nest)
         assert (read[pixels] > 0).all()
 
@@ -59,5 +64,7 @@ def test_partial_sky_files(cli, tmp_path):
     read = hp.read_map(str(path))
     assert (read == values).all()
     points = read_utk(cli("sphere", "-n", 2000, "--healpix-map", path, "--format", "bin"))
+    with pytest.warns(RuntimeWarning, match="UNSEEN"):
+        assert tessera.sphere(2000, healpix=path).tobytes() == points.tobytes()
     pixels = hp.vec2pix(nside, *points.T)
     assert ((pixels >= 100) & (pixels < 140)).all()
