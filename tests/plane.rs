@@ -716,3 +716,39 @@ fn streams_across_blocks_equal_the_fast_path() {
         assert!(streamed == fast, "{system:?}");
     }
 }
+
+/// Unsorted samples written as they are computed equal the in-memory
+/// unsorted path's, sample for sample: varying densities across several
+/// batches, exact and expected counts, every system, and uniform ones
+/// (streamed codes).
+#[test]
+fn unsorted_batches_equal_the_in_memory_unsorted_path() {
+    fn check<S: TileSystem<Point = DVec2, Region = PlaneRegion>>(
+        name: &str,
+        tiling: &S,
+        density: &dyn Density<PlaneRegion>,
+        count: usize,
+        exact: bool,
+    ) {
+        let mut buffers = engine::Buffers::default();
+        let in_memory =
+            engine::generate_into(tiling, density, count, exact, Order::Unsorted, &mut buffers)
+                .unwrap();
+        let samples = engine::unsorted(tiling, density, count, exact).unwrap();
+        assert_eq!(samples.len(), in_memory.len(), "{name} {count} {exact}");
+        let streamed: Vec<_> = samples.collect();
+        assert!(streamed == in_memory, "{name} {count} {exact}");
+    }
+    let image = Raster::new(96, 64, photograph(96, 64, 3), false).unwrap();
+    for (system, tiling) in systems() {
+        let name = format!("{system:?}");
+        for (count, exact) in [(1, true), (3000, true), (1_500_000, true), (200_000, false)] {
+            check(&name, &tiling, &Ramp, count, exact);
+        }
+        check(&name, &tiling, &image, 400_000, true);
+        check(&name, &tiling, &Uniform, 300_000, true);
+    }
+    let penrose = PenroseTiling::default();
+    check("penrose", &penrose, &Ramp, 700_000, true);
+    check("penrose", &penrose, &image, 5000, false);
+}

@@ -379,3 +379,39 @@ fn streams_across_blocks_equal_the_fast_path() {
     let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
     assert!(streamed == fast);
 }
+
+/// Unsorted sphere samples written as they are computed equal the
+/// in-memory unsorted path's: a cap across several batches, a combination
+/// of caps, and uniform (streamed codes).
+#[test]
+fn unsorted_batches_equal_the_in_memory_unsorted_path() {
+    let tiling = SphereTiling::default();
+    let cap = Cap::new(10.0, 20.0, 30.0, 10.0).unwrap();
+    let regions = tessera::density::region::Regions::parse(&[
+        "cap:-120,-80,3,1000",
+        "polygon:-10 30,40 30,40 70,-10 70;16",
+    ])
+    .unwrap();
+    for (count, exact) in [(1, true), (5000, true), (1_200_000, true), (300_000, false)] {
+        for density in [
+            &cap as &dyn tessera::density::Density<_>,
+            &regions,
+            &Uniform,
+        ] {
+            let mut buffers = engine::Buffers::default();
+            let in_memory = engine::generate_into(
+                &tiling,
+                density,
+                count,
+                exact,
+                engine::Order::Unsorted,
+                &mut buffers,
+            )
+            .unwrap();
+            let streamed: Vec<_> = engine::unsorted(&tiling, density, count, exact)
+                .unwrap()
+                .collect();
+            assert!(streamed == in_memory, "{count} {exact}");
+        }
+    }
+}

@@ -57,6 +57,7 @@
 
 mod ranking;
 mod stream;
+mod unsorted;
 mod walker;
 
 use crate::density::{Density, Region};
@@ -66,6 +67,7 @@ use crate::tiling::TileSystem;
 use crate::Error;
 use ranking::{by_rank, smallest_ranks, RankBuckets};
 pub use stream::{stream, Stream};
+pub use unsorted::{unsorted, Unsorted};
 use walker::collect_parts;
 
 /// Every sample the tiling accepts when `magnitude` samples are expected
@@ -362,12 +364,7 @@ where
             return Ok(out);
         }
     }
-    // the safety margin of an exact request (see above)
-    let mut magnitude = if exact {
-        count as f64 + 2.0 * (count as f64).sqrt()
-    } else {
-        count as f64
-    };
+    let mut magnitude = first_magnitude(count, exact);
     // ranks are counted as each root finishes, for the ranking
     let mut collect = |magnitude: f64, parts: &mut Vec<_>| {
         let buckets = RankBuckets::for_magnitude(magnitude);
@@ -379,25 +376,17 @@ where
     };
     let (mut buckets, mut in_range) = collect(magnitude, parts);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
-    for _ in 0..40 {
+    for _ in 0..MAGNITUDE_ROUNDS {
         let found = total(parts);
         if !exact || found >= count {
             break;
         }
-        let growth = if found == 0 {
-            4.0
-        } else {
-            (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0)
-        };
-        magnitude *= growth;
+        magnitude *= growth(count, found);
         (buckets, in_range) = collect(magnitude, parts);
     }
     if exact && total(parts) < count {
-        let found = total(parts);
-        return refuse(
-            out,
-            format!("only {found} samples fit at the deepest level; {count} were requested"),
-        );
+        out.clear();
+        return Err(too_few(total(parts), count));
     }
     let keep = if exact { count } else { usize::MAX };
     match order {
@@ -405,6 +394,34 @@ where
         Order::Unsorted => smallest_ranks(parts, (buckets, histograms), keep, out),
     }
     Ok(out)
+}
+
+/// The magnitude a request of `count` samples starts from: with the
+/// safety margin of an exact request (see above).
+fn first_magnitude(count: usize, exact: bool) -> f64 {
+    match exact {
+        true => count as f64 + 2.0 * (count as f64).sqrt(),
+        false => count as f64,
+    }
+}
+
+/// Rounds of the search for an exact request's magnitude.
+const MAGNITUDE_ROUNDS: usize = 40;
+
+/// The factor an exact request's magnitude grows by when the last one
+/// gave `found` of its `count` samples.
+fn growth(count: usize, found: usize) -> f64 {
+    match found {
+        0 => 4.0,
+        _ => (count as f64 / found as f64 * 1.01).clamp(1.001, 4.0),
+    }
+}
+
+/// The refusal of a request the deepest level cannot hold.
+fn too_few(found: usize, count: usize) -> Error {
+    Error::Request(format!(
+        "only {found} samples fit at the deepest level; {count} were requested"
+    ))
 }
 
 /// The pdf (per unit measure of the domain) the samples follow at a point.

@@ -44,15 +44,9 @@ where
     // of a huge request) reserves little
     let shares: Vec<usize> = starts
         .iter()
-        .map(|start| {
-            if window.is_some() {
-                return 16;
-            }
-            let average = walker
-                .constant
-                .unwrap_or_else(|| density.average(&system.region(&start.tile)));
-            let expected = magnitude * (average / walker.mean) * start.share;
-            (expected * 1.05).min(MAX_SHARE_HINT) as usize + 16
+        .map(|start| match window {
+            Some(_) => 16,
+            None => (walker.expected(start) * 1.05).min(MAX_SHARE_HINT) as usize + 16,
         })
         .collect();
     let chunks = chunk_roots(&shares, window.is_some(), threads);
@@ -108,7 +102,7 @@ pub(super) fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec
 }
 /// A tile the recursion starts from (see [`Walker::starts`]).
 pub(super) struct Start<T> {
-    tile: T,
+    pub(super) tile: T,
     /// About the tile's part of the domain (`1 / roots` for a root, split
     /// evenly among children): a hint for the output's reservation.
     share: f64,
@@ -156,7 +150,7 @@ where
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
-    fn new(
+    pub(super) fn new(
         system: &'a S,
         density: &'a D,
         magnitude: f64,
@@ -207,7 +201,7 @@ where
     /// it); the output is the same, in the same order, but a system of few
     /// roots (Penrose has one) gives every thread work. A window keeps the
     /// roots.
-    fn starts(&self, roots: Vec<S::Tile>, target: usize) -> Vec<Start<S::Tile>> {
+    pub(super) fn starts(&self, roots: Vec<S::Tile>, target: usize) -> Vec<Start<S::Tile>> {
         let share = 1.0 / roots.len().max(1) as f64;
         let mut starts: Vec<Start<S::Tile>> = roots
             .into_iter()
@@ -241,6 +235,45 @@ where
         starts
     }
 
+    /// About how many samples a start's subtree holds, by the density's
+    /// average over it.
+    pub(super) fn expected(&self, start: &Start<S::Tile>) -> f64 {
+        let average = self
+            .constant
+            .unwrap_or_else(|| self.density.average(&self.system.region(&start.tile)));
+        // `magnitude` is in code units
+        self.magnitude / self.system.codes_per_sample() * (average / self.mean) * start.share
+    }
+
+    /// `starts` with each start expected to hold more than `most` samples
+    /// replaced by its children, as [`Walker::starts`] replaces them (the
+    /// output is the same, in the same order), until none is or none can be.
+    pub(super) fn split_starts(
+        &self,
+        mut starts: Vec<Start<S::Tile>>,
+        most: f64,
+    ) -> Vec<Start<S::Tile>> {
+        loop {
+            let before = starts.len();
+            let mut next = Vec::with_capacity(before);
+            for start in starts {
+                if self.expected(&start) <= most || !self.recurses_into_all(&start.tile) {
+                    next.push(start);
+                    continue;
+                }
+                let count = self.system.child_count(&start.tile);
+                next.extend((0..count).map(|i| Start {
+                    tile: self.system.child(&start.tile, i),
+                    share: start.share / count as f64,
+                }));
+            }
+            starts = next;
+            if starts.len() == before {
+                return starts;
+            }
+        }
+    }
+
     /// Whether [`Walker::visit`] of a tile not terminal by its parent visits
     /// every child, with a bound that makes none of them terminal.
     fn recurses_into_all(&self, tile: &S::Tile) -> bool {
@@ -269,7 +302,7 @@ where
     /// too: a tile it already makes terminal needs no bound of its own (most
     /// tiles: those the recursion stops at), and one it also rejects is
     /// skipped before its region is computed.
-    fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
+    pub(super) fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
         let level = self.system.level(tile);
         let capacity = self.capacities[level as usize];
         let terminal_by_parent = capacity >= parent_bound;

@@ -1,0 +1,318 @@
+//! A request's samples in [`Order::Unsorted`](super::Order::Unsorted),
+//! written as they are computed: memory for a batch of the recursion's
+//! subtrees however many samples are drawn, at the cost of a second pass.
+
+use super::ranking::RankBuckets;
+use super::walker::{Start, Walker};
+use super::{stream, Sample, Stream};
+use crate::density::{Density, Region};
+use crate::tiling::TileSystem;
+use crate::Error;
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// The most samples a subtree is expected to hold before it is split into
+/// its children's: the unit the second pass computes and keeps in memory.
+const SUBTREE_SAMPLES: f64 = (1 << 14) as f64;
+/// Samples the second pass computes at a time, shared among the threads
+/// (16 MB of sphere samples).
+const BATCH_SAMPLES: f64 = (1 << 19) as f64;
+
+/// Samples of `density` over `system` in [`Order::Unsorted`](super::Order::Unsorted), the same
+/// as [`generate_into`](super::generate_into) gives, sample for sample, but
+/// computed a batch at a time. A varying density takes two passes over
+/// the recursion: the first counts the samples per rank bucket (the exact
+/// count's search for the request's magnitude takes such passes too), the
+/// second writes those below the cut bucket as they come and keeps the
+/// cut bucket's (about `count / 4096` of them) to write last, in rank
+/// order. A constant density streams its codes ([`stream`]).
+///
+/// # Example
+/// ```
+/// use tessera::{density::plane::Ramp, engine::{self, Order}, tiling::plane::PlaneTiling};
+/// let tiling = PlaneTiling::ppentomino();
+/// let streamed: Vec<_> = engine::unsorted(&tiling, &Ramp, 20_000, true).unwrap().collect();
+/// let mut buffers = engine::Buffers::default();
+/// let in_memory = engine::generate_into(&tiling, &Ramp, 20_000, true, Order::Unsorted, &mut buffers);
+/// assert_eq!(streamed, in_memory.unwrap());
+/// ```
+pub fn unsorted<'a, S, D>(
+    system: &'a S,
+    density: &'a D,
+    count: usize,
+    exact: bool,
+) -> Result<Unsorted<'a, S, D>, Error>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    let mean = density.mean();
+    if count > 0 && !(mean.is_finite() && mean > 0.0) {
+        return Err(Error::Request(format!(
+            "the density's mean over the domain is {mean}; it must be positive and finite"
+        )));
+    }
+    if count == 0 {
+        return Ok(Unsorted(Inner::Codes(None)));
+    }
+    if let Some(codes) = density.constant().and_then(|_| stream(system, count)) {
+        return Ok(Unsorted(Inner::Codes(Some(codes))));
+    }
+    // the magnitude search of `generate_into`, counting instead of keeping
+    let mut magnitude = super::first_magnitude(count, exact);
+    let mut counted = Counted::new(system, density, magnitude);
+    for _ in 0..super::MAGNITUDE_ROUNDS {
+        let found = counted.found();
+        if !exact || found >= count {
+            break;
+        }
+        magnitude *= super::growth(count, found);
+        counted = Counted::new(system, density, magnitude);
+    }
+    let found = counted.found();
+    if exact && found < count {
+        return Err(super::too_few(found, count));
+    }
+    let keep = if exact { count } else { usize::MAX };
+    Ok(Unsorted(Inner::Walk(Box::new(Walk::new(counted, keep)))))
+}
+
+/// The samples of [`unsorted`], an exact-size iterator.
+///
+/// # Example
+/// ```
+/// use tessera::{density::plane::Ramp, engine, tiling::plane::PlaneTiling};
+/// let tiling = PlaneTiling::ghexomino();
+/// let samples = engine::unsorted(&tiling, &Ramp, 1000, true).unwrap();
+/// assert_eq!(samples.len(), 1000);
+/// ```
+pub struct Unsorted<'a, S: TileSystem, D: ?Sized>(Inner<'a, S, D>);
+
+enum Inner<'a, S: TileSystem, D: ?Sized> {
+    /// A constant density's codes (none for an empty request).
+    Codes(Option<Stream<'a, S>>),
+    /// A varying density's recursion, in batches.
+    Walk(Box<Walk<'a, S, D>>),
+}
+
+impl<S, D> Iterator for Unsorted<'_, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    type Item = Sample<S::Point>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match &mut self.0 {
+            Inner::Codes(codes) => codes.as_mut()?.next(),
+            Inner::Walk(walk) => walk.next(),
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = match &self.0 {
+            Inner::Codes(codes) => codes.as_ref().map_or(0, ExactSizeIterator::len),
+            Inner::Walk(walk) => walk.left,
+        };
+        (left, Some(left))
+    }
+}
+
+impl<S, D> ExactSizeIterator for Unsorted<'_, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+}
+
+/// The first pass at one magnitude: the subtrees the recursion is cut
+/// into, and the samples per rank bucket over all of them.
+struct Counted<'a, S: TileSystem, D: ?Sized> {
+    walker: Walker<'a, S, D>,
+    starts: Vec<Start<S::Tile>>,
+    buckets: RankBuckets,
+    counts: Vec<usize>,
+}
+
+impl<'a, S, D> Counted<'a, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    fn new(system: &'a S, density: &'a D, magnitude: f64) -> Self {
+        let walker = Walker::new(system, density, magnitude, None);
+        let starts = walker.split_starts(walker.starts(system.roots(), 0), SUBTREE_SAMPLES);
+        let buckets = RankBuckets::for_magnitude(magnitude);
+        let add = |mut a: Vec<usize>, b: Vec<usize>| {
+            a.resize(a.len().max(b.len()), 0);
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+            a
+        };
+        let counts = starts
+            .par_iter()
+            .fold(
+                || (Vec::new(), Vec::new(), Vec::new()),
+                |(totals, mut samples, mut counts), start| {
+                    samples.clear();
+                    counts.clear();
+                    walker.visit(&start.tile, f64::INFINITY, &mut samples);
+                    buckets.count_into(&samples, &mut counts);
+                    let totals = add(totals, counts.iter().map(|&c| c as usize).collect());
+                    (totals, samples, counts)
+                },
+            )
+            .map(|(totals, _, _)| totals)
+            .reduce(Vec::new, add);
+        Counted {
+            walker,
+            starts,
+            buckets,
+            counts,
+        }
+    }
+
+    fn found(&self) -> usize {
+        self.counts.iter().sum()
+    }
+}
+
+/// The second pass: subtrees computed a batch at a time, in order.
+struct Walk<'a, S: TileSystem, D: ?Sized> {
+    counted: Counted<'a, S, D>,
+    /// Consecutive subtrees computed together.
+    batches: Vec<Range<usize>>,
+    next_batch: usize,
+    /// Samples of buckets below this one are written in recursion order
+    /// (all of them when it is `usize::MAX`).
+    cut: usize,
+    /// How many of the cut bucket's samples are kept: its smallest ranks.
+    need: usize,
+    /// The cut bucket's samples, with their place in recursion order
+    /// (which breaks ties of rank).
+    aside: Vec<(f64, usize, Sample<S::Point>)>,
+    /// Samples visited so far in recursion order.
+    seen: usize,
+    /// One list per subtree of a batch (memory reused).
+    lists: Vec<Vec<Sample<S::Point>>>,
+    /// The samples ready to yield, and the next one.
+    ready: Vec<Sample<S::Point>>,
+    at: usize,
+    /// Whether the cut bucket's samples were moved to `ready`.
+    finished: bool,
+    left: usize,
+}
+
+impl<'a, S, D> Walk<'a, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    /// The selection of `smallest_ranks` (see `ranking`), from the counts.
+    fn new(counted: Counted<'a, S, D>, keep: usize) -> Self {
+        let n = counted.found();
+        let (cut, need, left) = if keep >= n {
+            (usize::MAX, 0, n)
+        } else {
+            let (mut cut, mut below) = (0, 0);
+            while below + counted.counts[cut] < keep {
+                below += counted.counts[cut];
+                cut += 1;
+            }
+            (cut, keep - below, keep)
+        };
+        let mut batches = Vec::new();
+        let (mut from, mut size) = (0, 0.0);
+        for (k, start) in counted.starts.iter().enumerate() {
+            size += counted.walker.expected(start);
+            if size >= BATCH_SAMPLES {
+                batches.push(from..k + 1);
+                (from, size) = (k + 1, 0.0);
+            }
+        }
+        if from < counted.starts.len() {
+            batches.push(from..counted.starts.len());
+        }
+        Walk {
+            counted,
+            batches,
+            next_batch: 0,
+            cut,
+            need,
+            aside: Vec::new(),
+            seen: 0,
+            lists: Vec::new(),
+            ready: Vec::new(),
+            at: 0,
+            finished: false,
+            left,
+        }
+    }
+
+    /// Computes the next batch's subtrees (in parallel) into `ready`, the
+    /// cut bucket's samples aside.
+    fn compute_batch(&mut self) {
+        let batch = self.batches[self.next_batch].clone();
+        self.next_batch += 1;
+        let (walker, starts) = (&self.counted.walker, &self.counted.starts[batch]);
+        self.lists
+            .resize_with(self.lists.len().max(starts.len()), Vec::new);
+        self.lists[..starts.len()]
+            .par_iter_mut()
+            .zip(starts)
+            .for_each(|(list, start)| {
+                list.clear();
+                walker.visit(&start.tile, f64::INFINITY, list);
+            });
+        self.ready.clear();
+        self.at = 0;
+        let buckets = self.counted.buckets;
+        for s in self.lists[..starts.len()].iter().flatten() {
+            let b = if self.cut == usize::MAX {
+                0
+            } else {
+                buckets.of(s.rank)
+            };
+            if b < self.cut {
+                self.ready.push(*s);
+            } else if b == self.cut {
+                self.aside.push((s.rank, self.seen, *s));
+            }
+            self.seen += 1;
+        }
+    }
+}
+
+impl<S, D> Iterator for Walk<'_, S, D>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    type Item = Sample<S::Point>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while self.at == self.ready.len() {
+            if self.next_batch < self.batches.len() {
+                self.compute_batch();
+            } else if !self.finished {
+                self.finished = true;
+                let mut aside = std::mem::take(&mut self.aside);
+                aside.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                self.ready.clear();
+                self.ready
+                    .extend(aside.iter().take(self.need).map(|&(_, _, s)| s));
+                self.at = 0;
+            } else {
+                return None;
+            }
+        }
+        self.at += 1;
+        self.left -= 1;
+        Some(self.ready[self.at - 1])
+    }
+}
