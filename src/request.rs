@@ -202,41 +202,67 @@ impl SphereRequest {
                 .filter(|&p| window.contains(p))
                 .collect());
         }
+        struct InMemory<'r> {
+            request: &'r SphereRequest,
+            tiling: SphereTiling,
+        }
+        impl InFrame<SphereRegion> for InMemory<'_> {
+            type Out = Result<Vec<DVec3>, Error>;
+            fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
+            where
+                D: Density<SphereRegion> + ?Sized,
+                W: Fn(DVec3) -> DVec3,
+            {
+                let request = self.request;
+                let samples = engine::generate_ordered(
+                    &self.tiling,
+                    density,
+                    request.count,
+                    !request.expected,
+                    request.order,
+                )?;
+                request.finish(samples, density, to_world)
+            }
+        }
+        self.in_frame(
+            density,
+            InMemory {
+                request: self,
+                tiling,
+            },
+        )
+    }
+
+    /// `job` run on the density in the frame it is sampled in (rotated by
+    /// the request's seed), with the map from that frame to the world.
+    fn in_frame<J: InFrame<SphereRegion>>(&self, density: &SphereDensity, job: J) -> J::Out {
         match (density, self.seed) {
             (SphereDensity::Map(map), seed) => {
                 let map = match seed {
                     Some(seed) => map.with_seed(seed),
                     None => map.clone(),
                 };
-                let samples = self.samples(&tiling, &map)?;
-                self.finish(samples, &map, |p| map.to_world(p))
+                job.run(&map, |p| map.to_world(p))
             }
             (SphereDensity::Healpix(map), Some(seed)) => {
                 let rotated = Rotated::new(map, seed);
-                let samples = self.samples(&tiling, &rotated)?;
-                self.finish(samples, &rotated, |p| rotated.to_world(p))
+                job.run(&rotated, |p| rotated.to_world(p))
             }
-            (SphereDensity::Healpix(map), None) => {
-                let samples = self.samples(&tiling, map)?;
-                self.finish(samples, map, |p| p)
-            }
+            (SphereDensity::Healpix(map), None) => job.run(map, |p| p),
             (SphereDensity::Regions(density), Some(seed)) => {
                 let rotated = Rotated::new(&**density, seed);
-                let samples = self.samples(&tiling, &rotated)?;
-                self.finish(samples, &rotated, |p| rotated.to_world(p))
+                job.run(&rotated, |p| rotated.to_world(p))
             }
-            (SphereDensity::Regions(density), None) => {
-                let samples = self.samples(&tiling, &**density)?;
-                self.finish(samples, &**density, |p| p)
-            }
+            (SphereDensity::Regions(density), None) => job.run(&**density, |p| p),
         }
     }
 
     /// [`SphereRequest::points`] handed to `sink` as an exact-size
     /// iterator: a uniform request (without window or relaxation) streams
-    /// block by block in bounded memory where [`STREAM_ABOVE`] says so,
-    /// others are generated in memory first. This is how `tessera sphere`
-    /// writes.
+    /// block by block in bounded memory where [`STREAM_ABOVE`] says so, an
+    /// unsorted one (without window or relaxation) a batch at a time
+    /// ([`engine::unsorted`]); others are generated in memory first. This
+    /// is how `tessera sphere` writes.
     ///
     /// # Example
     /// ```
@@ -267,15 +293,39 @@ impl SphereRequest {
                 _ => {}
             }
         }
+        if self.order == Order::Unsorted && self.within.is_none() && self.relax == 0 {
+            struct Batches<'r, F> {
+                request: &'r SphereRequest,
+                tiling: SphereTiling,
+                sink: F,
+            }
+            impl<F, R> InFrame<SphereRegion> for Batches<'_, F>
+            where
+                F: FnOnce(&mut dyn ExactSizeIterator<Item = DVec3>) -> R,
+            {
+                type Out = Result<R, Error>;
+                fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
+                where
+                    D: Density<SphereRegion> + ?Sized,
+                    W: Fn(DVec3) -> DVec3,
+                {
+                    let (count, exact) = (self.request.count, !self.request.expected);
+                    let samples = engine::unsorted(&self.tiling, density, count, exact)?;
+                    Ok((self.sink)(&mut samples.map(|s| to_world(s.position))))
+                }
+            }
+            let tiling = self.tiling()?;
+            return self.in_frame(
+                density,
+                Batches {
+                    request: self,
+                    tiling,
+                    sink,
+                },
+            );
+        }
         let points = self.points(density)?;
         Ok(sink(&mut points.into_iter()))
-    }
-
-    fn samples<D>(&self, tiling: &SphereTiling, density: &D) -> Result<Vec<Sample<DVec3>>, Error>
-    where
-        D: Density<SphereRegion> + ?Sized,
-    {
-        engine::generate_ordered(tiling, density, self.count, !self.expected, self.order)
     }
 
     /// The positions of `samples` (in `density`'s sampling frame), relaxed,
@@ -298,6 +348,17 @@ impl SphereRequest {
         crate::relax::relax(&mut points, density, self.relax)?;
         Ok(points.into_iter().map(to_world).collect())
     }
+}
+
+/// A job run on a request's density in its sampling frame (see
+/// `SphereRequest::in_frame` and `PlaneRequest::in_frame`): generic over
+/// the density, so that each kind is sampled without dynamic dispatch.
+trait InFrame<R: crate::density::Region> {
+    type Out;
+    fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
+    where
+        D: Density<R> + ?Sized,
+        W: Fn(R::Point) -> R::Point;
 }
 
 /// Something worth telling about a map that was read all the same.
@@ -690,8 +751,9 @@ impl PlaneRequest {
 
     /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
     /// a uniform request on the unit square without seed streams block by
-    /// block in bounded memory where [`STREAM_ABOVE`] says so. This is how
-    /// `tessera plane` writes.
+    /// block in bounded memory where [`STREAM_ABOVE`] says so, an unsorted
+    /// one a batch at a time ([`engine::unsorted`]). This is how `tessera
+    /// plane` writes.
     ///
     /// # Example
     /// ```
@@ -712,6 +774,50 @@ impl PlaneRequest {
             if let Some(mut points) = stream {
                 return Ok(sink(&mut *points));
             }
+        }
+        if self.order == Order::Unsorted {
+            struct Batches<'t, S, F> {
+                tiling: &'t S,
+                count: usize,
+                exact: bool,
+                sink: F,
+            }
+            impl<S, F, R> InFrame<PlaneRegion> for Batches<'_, S, F>
+            where
+                S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+                F: FnOnce(&mut dyn ExactSizeIterator<Item = DVec2>) -> R,
+            {
+                type Out = Result<R, Error>;
+                fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
+                where
+                    D: Density<PlaneRegion> + ?Sized,
+                    W: Fn(DVec2) -> DVec2,
+                {
+                    let samples = engine::unsorted(self.tiling, density, self.count, self.exact)?;
+                    Ok((self.sink)(&mut samples.map(|s| to_world(s.position))))
+                }
+            }
+            let (count, exact) = (self.count, !self.expected);
+            return match self.tiling()? {
+                Tiling::Penrose(tiling) => self.in_frame(
+                    density,
+                    Batches {
+                        tiling: &tiling,
+                        count,
+                        exact,
+                        sink,
+                    },
+                ),
+                Tiling::Polyomino(tiling) => self.in_frame(
+                    density,
+                    Batches {
+                        tiling: &*tiling,
+                        count,
+                        exact,
+                        sink,
+                    },
+                ),
+            };
         }
         let points = self.points(density)?;
         Ok(sink(&mut points.into_iter()))
@@ -746,30 +852,57 @@ impl PlaneRequest {
     where
         S: TileSystem<Point = DVec2, Region = PlaneRegion>,
     {
+        struct InMemory<'r, S> {
+            request: &'r PlaneRequest,
+            tiling: &'r S,
+        }
+        impl<S> InFrame<PlaneRegion> for InMemory<'_, S>
+        where
+            S: TileSystem<Point = DVec2, Region = PlaneRegion>,
+        {
+            type Out = Result<Vec<DVec2>, Error>;
+            fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
+            where
+                D: Density<PlaneRegion> + ?Sized,
+                W: Fn(DVec2) -> DVec2,
+            {
+                let r = self.request;
+                let samples =
+                    engine::generate_ordered(self.tiling, density, r.count, !r.expected, r.order)?;
+                // (`into_iter` and `collect` reuse the samples' memory)
+                Ok(samples.into_iter().map(|s| to_world(s.position)).collect())
+            }
+        }
+        self.in_frame(
+            density,
+            InMemory {
+                request: self,
+                tiling,
+            },
+        )
+    }
+
+    /// `job` run on the density of the unit square (the domain's, shifted
+    /// by the request's seed), with the map from the square to the domain.
+    fn in_frame<J: InFrame<PlaneRegion>>(
+        &self,
+        density: &dyn Density<PlaneRegion>,
+        job: J,
+    ) -> J::Out {
         let restricted = self.domain.map(|rect| rect.restrict(density));
         let square: &dyn Density<PlaneRegion> = match &restricted {
             Some(r) => r,
             None => density,
         };
-        let exact = !self.expected;
-        // (`into_iter` and `collect` reuse the samples' memory)
-        let in_square: Vec<DVec2> = match self.seed {
+        let domain = self.domain;
+        let to_domain = move |p: DVec2| domain.map_or(p, |rect| rect.to_world(p));
+        match self.seed {
             Some(seed) => {
                 let shifted = Shifted::new(square, seed);
-                engine::generate_ordered(tiling, &shifted, self.count, exact, self.order)?
-                    .into_iter()
-                    .map(|s| shifted.to_world(s.position))
-                    .collect()
+                job.run(&shifted, |p| to_domain(shifted.to_world(p)))
             }
-            None => engine::generate_ordered(tiling, square, self.count, exact, self.order)?
-                .into_iter()
-                .map(|s| s.position)
-                .collect(),
-        };
-        Ok(match self.domain {
-            Some(rect) => in_square.into_iter().map(|p| rect.to_world(p)).collect(),
-            None => in_square,
-        })
+            None => job.run(square, to_domain),
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! subtrees however many samples are drawn, at the cost of a second pass.
 
 use super::ranking::RankBuckets;
-use super::walker::{Start, Walker};
+use super::walker::Walker;
 use super::{stream, Sample, Stream};
 use crate::density::{Density, Region};
 use crate::tiling::TileSystem;
@@ -16,7 +16,7 @@ use std::ops::Range;
 const SUBTREE_SAMPLES: f64 = (1 << 14) as f64;
 /// Samples the second pass computes at a time, shared among the threads
 /// (16 MB of sphere samples).
-const BATCH_SAMPLES: f64 = (1 << 19) as f64;
+const BATCH_SAMPLES: usize = 1 << 19;
 
 /// Samples of `density` over `system` in [`Order::Unsorted`](super::Order::Unsorted), the same
 /// as [`generate_into`](super::generate_into) gives, sample for sample, but
@@ -132,7 +132,9 @@ where
 /// into, and the samples per rank bucket over all of them.
 struct Counted<'a, S: TileSystem, D: ?Sized> {
     walker: Walker<'a, S, D>,
-    starts: Vec<Start<S::Tile>>,
+    starts: Vec<S::Tile>,
+    /// The samples of each start's subtree.
+    sizes: Vec<usize>,
     buckets: RankBuckets,
     counts: Vec<usize>,
 }
@@ -145,46 +147,80 @@ where
 {
     fn new(system: &'a S, density: &'a D, magnitude: f64) -> Self {
         let walker = Walker::new(system, density, magnitude, None);
-        let starts = walker.split_starts(walker.starts(system.roots(), 0), SUBTREE_SAMPLES);
+        let big = |tile: &S::Tile| walker.expected(tile) > SUBTREE_SAMPLES;
+        let starts = walker.split(system.roots(), |_| true, big);
         let buckets = RankBuckets::for_magnitude(magnitude);
         let add = |mut a: Vec<usize>, b: Vec<usize>| {
             a.resize(a.len().max(b.len()), 0);
             a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
             a
         };
-        let counts = starts
+        // per thread: the counts per bucket, each start's size, and the
+        // lists a start is visited into (memory reused)
+        let (counts, sized) = starts
             .par_iter()
+            .enumerate()
             .fold(
-                || (Vec::new(), Vec::new(), Vec::new()),
-                |(totals, mut samples, mut counts), start| {
+                || (Vec::new(), Vec::new(), Vec::new(), Vec::new()),
+                |(totals, mut sized, mut samples, mut counts), (k, start)| {
                     samples.clear();
                     counts.clear();
-                    walker.visit(&start.tile, f64::INFINITY, &mut samples);
+                    walker.visit(start, f64::INFINITY, &mut samples);
                     buckets.count_into(&samples, &mut counts);
+                    sized.push((k, samples.len()));
                     let totals = add(totals, counts.iter().map(|&c| c as usize).collect());
-                    (totals, samples, counts)
+                    (totals, sized, samples, counts)
                 },
             )
-            .map(|(totals, _, _)| totals)
-            .reduce(Vec::new, add);
+            .map(|(totals, sized, _, _)| (totals, sized))
+            .reduce(
+                || (Vec::new(), Vec::new()),
+                |(a, mut sized), (b, more)| {
+                    sized.extend(more);
+                    (add(a, b), sized)
+                },
+            );
+        let mut sizes = vec![0; starts.len()];
+        for (k, size) in sized {
+            sizes[k] = size;
+        }
         Counted {
             walker,
             starts,
+            sizes,
             buckets,
             counts,
         }
     }
 
     fn found(&self) -> usize {
-        self.counts.iter().sum()
+        self.sizes.iter().sum()
     }
+}
+
+/// Consecutive runs of `sizes` (and their sums) of at least `least` each
+/// but the last.
+fn runs(sizes: &[usize], least: usize) -> Vec<(Range<usize>, usize)> {
+    let mut runs = Vec::new();
+    let (mut from, mut sum) = (0, 0);
+    for (k, &size) in sizes.iter().enumerate() {
+        sum += size;
+        if sum >= least {
+            runs.push((from..k + 1, sum));
+            (from, sum) = (k + 1, 0);
+        }
+    }
+    if from < sizes.len() {
+        runs.push((from..sizes.len(), sum));
+    }
+    runs
 }
 
 /// The second pass: subtrees computed a batch at a time, in order.
 struct Walk<'a, S: TileSystem, D: ?Sized> {
     counted: Counted<'a, S, D>,
-    /// Consecutive subtrees computed together.
-    batches: Vec<Range<usize>>,
+    /// Consecutive subtrees computed together, and their samples.
+    batches: Vec<(Range<usize>, usize)>,
     next_batch: usize,
     /// Samples of buckets below this one are written in recursion order
     /// (all of them when it is `usize::MAX`).
@@ -196,12 +232,12 @@ struct Walk<'a, S: TileSystem, D: ?Sized> {
     aside: Vec<(f64, usize, Sample<S::Point>)>,
     /// Samples visited so far in recursion order.
     seen: usize,
-    /// One list per subtree of a batch (memory reused).
+    /// The batch's samples, a list per thread's run of its subtrees
+    /// (memory reused), and the next one to look at.
     lists: Vec<Vec<Sample<S::Point>>>,
-    /// The samples ready to yield, and the next one.
-    ready: Vec<Sample<S::Point>>,
-    at: usize,
-    /// Whether the cut bucket's samples were moved to `ready`.
+    at: (usize, usize),
+    /// Whether the last batch was computed and the cut bucket's kept
+    /// samples moved to the only list.
     finished: bool,
     left: usize,
 }
@@ -225,18 +261,7 @@ where
             }
             (cut, keep - below, keep)
         };
-        let mut batches = Vec::new();
-        let (mut from, mut size) = (0, 0.0);
-        for (k, start) in counted.starts.iter().enumerate() {
-            size += counted.walker.expected(start);
-            if size >= BATCH_SAMPLES {
-                batches.push(from..k + 1);
-                (from, size) = (k + 1, 0.0);
-            }
-        }
-        if from < counted.starts.len() {
-            batches.push(from..counted.starts.len());
-        }
+        let batches = runs(&counted.sizes, BATCH_SAMPLES);
         Walk {
             counted,
             batches,
@@ -246,44 +271,60 @@ where
             aside: Vec::new(),
             seen: 0,
             lists: Vec::new(),
-            ready: Vec::new(),
-            at: 0,
+            at: (0, 0),
             finished: false,
             left,
         }
     }
 
-    /// Computes the next batch's subtrees (in parallel) into `ready`, the
-    /// cut bucket's samples aside.
+    /// Computes the next batch's subtrees into `lists`, a run of them a
+    /// thread.
     fn compute_batch(&mut self) {
-        let batch = self.batches[self.next_batch].clone();
+        let (batch, size) = self.batches[self.next_batch].clone();
         self.next_batch += 1;
-        let (walker, starts) = (&self.counted.walker, &self.counted.starts[batch]);
+        let walker = &self.counted.walker;
+        let (starts, sizes) = (
+            &self.counted.starts[batch.clone()],
+            &self.counted.sizes[batch],
+        );
+        // about a thread's share of the samples each
+        let share = size.div_ceil(rayon::current_num_threads()).max(1);
+        let runs = runs(sizes, share);
+        self.lists.resize_with(runs.len(), Vec::new);
         self.lists
-            .resize_with(self.lists.len().max(starts.len()), Vec::new);
-        self.lists[..starts.len()]
             .par_iter_mut()
-            .zip(starts)
-            .for_each(|(list, start)| {
+            .zip(&runs)
+            .for_each(|(list, (run, size))| {
                 list.clear();
-                walker.visit(&start.tile, f64::INFINITY, list);
+                list.reserve_exact(*size);
+                for start in &starts[run.clone()] {
+                    walker.visit(start, f64::INFINITY, list);
+                }
             });
-        self.ready.clear();
-        self.at = 0;
+        self.at = (0, 0);
+    }
+
+    /// The next sample of the lists that is kept in recursion order, the
+    /// cut bucket's set aside on the way.
+    fn next_in_lists(&mut self) -> Option<Sample<S::Point>> {
         let buckets = self.counted.buckets;
-        for s in self.lists[..starts.len()].iter().flatten() {
-            let b = if self.cut == usize::MAX {
-                0
-            } else {
-                buckets.of(s.rank)
+        while let Some(list) = self.lists.get(self.at.0) {
+            let Some(&s) = list.get(self.at.1) else {
+                self.at = (self.at.0 + 1, 0);
+                continue;
             };
-            if b < self.cut {
-                self.ready.push(*s);
-            } else if b == self.cut {
-                self.aside.push((s.rank, self.seen, *s));
-            }
+            self.at.1 += 1;
             self.seen += 1;
+            if self.cut == usize::MAX || self.finished {
+                return Some(s);
+            }
+            match buckets.of(s.rank) {
+                b if b < self.cut => return Some(s),
+                b if b == self.cut => self.aside.push((s.rank, self.seen - 1, s)),
+                _ => {}
+            }
         }
+        None
     }
 }
 
@@ -296,23 +337,24 @@ where
     type Item = Sample<S::Point>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        while self.at == self.ready.len() {
+        loop {
+            if let Some(s) = self.next_in_lists() {
+                self.left -= 1;
+                return Some(s);
+            }
             if self.next_batch < self.batches.len() {
                 self.compute_batch();
             } else if !self.finished {
+                // the cut bucket's smallest ranks, last, in rank order
                 self.finished = true;
                 let mut aside = std::mem::take(&mut self.aside);
                 aside.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                self.ready.clear();
-                self.ready
-                    .extend(aside.iter().take(self.need).map(|&(_, _, s)| s));
-                self.at = 0;
+                let kept = aside.iter().take(self.need).map(|&(_, _, s)| s);
+                self.lists = vec![kept.collect()];
+                self.at = (0, 0);
             } else {
                 return None;
             }
         }
-        self.at += 1;
-        self.left -= 1;
-        Some(self.ready[self.at - 1])
     }
 }

@@ -67,7 +67,7 @@ where
             let mut in_range = true;
             for start in &starts[chunk.clone()] {
                 let from = out.len();
-                walker.visit(&start.tile, f64::INFINITY, out);
+                walker.visit(start, f64::INFINITY, out);
                 // counted while the start's samples are still in cache
                 in_range &= buckets.is_none_or(|b| b.count_into(&out[from..], counts));
             }
@@ -100,17 +100,10 @@ pub(super) fn chunk_roots(shares: &[usize], window: bool, threads: usize) -> Vec
     }
     chunks
 }
-/// A tile the recursion starts from (see [`Walker::starts`]).
-pub(super) struct Start<T> {
-    pub(super) tile: T,
-    /// About the tile's part of the domain (`1 / roots` for a root, split
-    /// evenly among children): a hint for the output's reservation.
-    share: f64,
-}
 /// Starts a thread where roots are few (see [`Walker::starts`]): many, as
-/// their shares of the samples are rough guesses (split evenly among
-/// children) and the lists cut from them by those shares balance only when
-/// each start is small. On 2 threads, Penrose at 10^6 uniform samples took
+/// their shares of the samples are estimates ([`Walker::expected`]) and
+/// the lists cut from them by those shares balance only when each start
+/// is small. On 2 threads, Penrose at 10^6 uniform samples took
 /// 109, 86 and 76 ms with 8, 32 and 128 starts a thread (137 ms on one
 /// thread; scratch timer, median of 30).
 pub(super) const STARTS_A_THREAD: usize = 128;
@@ -195,83 +188,63 @@ where
     }
 
     /// The tiles to visit, in order: the roots, each replaced by its
-    /// children while there are fewer than `target` and it recurses into
-    /// every child with a bound that makes none of them terminal (so its
-    /// bound decides nothing for them: visiting them as roots is visiting
-    /// it); the output is the same, in the same order, but a system of few
-    /// roots (Penrose has one) gives every thread work. A window keeps the
-    /// roots.
-    pub(super) fn starts(&self, roots: Vec<S::Tile>, target: usize) -> Vec<Start<S::Tile>> {
-        let share = 1.0 / roots.len().max(1) as f64;
-        let mut starts: Vec<Start<S::Tile>> = roots
-            .into_iter()
-            .map(|tile| Start { tile, share })
-            .collect();
+    /// children while there are fewer than `target` (see [`Walker::split`]),
+    /// so that a system of few roots (Penrose has one) gives every thread
+    /// work. A window keeps the roots.
+    pub(super) fn starts(&self, roots: Vec<S::Tile>, target: usize) -> Vec<S::Tile> {
         if self.window.is_some() {
-            return starts;
+            return roots;
         }
-        for _ in 0..MAX_START_ROUNDS {
-            if starts.len() >= target {
-                break;
-            }
-            let before = starts.len();
-            let mut next = Vec::with_capacity(before * 4);
-            for start in starts {
-                if !self.recurses_into_all(&start.tile) {
-                    next.push(start);
-                    continue;
-                }
-                let count = self.system.child_count(&start.tile);
-                next.extend((0..count).map(|i| Start {
-                    tile: self.system.child(&start.tile, i),
-                    share: start.share / count as f64,
-                }));
-            }
-            starts = next;
-            if starts.len() == before {
-                break;
-            }
-        }
-        starts
+        let mut rounds = 0;
+        let more = |tiles: &[S::Tile]| {
+            rounds += 1;
+            rounds <= MAX_START_ROUNDS && tiles.len() < target
+        };
+        self.split(roots, more, |_| true)
     }
 
-    /// About how many samples a start's subtree holds, by the density's
-    /// average over it.
-    pub(super) fn expected(&self, start: &Start<S::Tile>) -> f64 {
+    /// `tiles` with each tile that `wanted` picks replaced by its children
+    /// where its visit recurses into every child with a bound that makes
+    /// none of them terminal (so its bound decides nothing for them:
+    /// visiting them as roots is visiting it, and the output is the same,
+    /// in the same order), round after round while `more` allows and some
+    /// tile was replaced.
+    pub(super) fn split(
+        &self,
+        mut tiles: Vec<S::Tile>,
+        mut more: impl FnMut(&[S::Tile]) -> bool,
+        wanted: impl Fn(&S::Tile) -> bool,
+    ) -> Vec<S::Tile> {
+        while more(&tiles) {
+            let mut next = Vec::with_capacity(tiles.len());
+            let mut split = false;
+            for tile in tiles {
+                if !(wanted(&tile) && self.recurses_into_all(&tile)) {
+                    next.push(tile);
+                    continue;
+                }
+                // (a Penrose triangle may have a single child)
+                split = true;
+                let count = self.system.child_count(&tile);
+                next.extend((0..count).map(|i| self.system.child(&tile, i)));
+            }
+            tiles = next;
+            if !split {
+                break;
+            }
+        }
+        tiles
+    }
+
+    /// About how many samples a tile's subtree holds: its density's
+    /// average in code units over the codes of its level (each of the
+    /// level's codes stands for a tile's share of the domain, and a root
+    /// may reach beyond the domain, as Penrose's does).
+    pub(super) fn expected(&self, tile: &S::Tile) -> f64 {
         let average = self
             .constant
-            .unwrap_or_else(|| self.density.average(&self.system.region(&start.tile)));
-        // `magnitude` is in code units
-        self.magnitude / self.system.codes_per_sample() * (average / self.mean) * start.share
-    }
-
-    /// `starts` with each start expected to hold more than `most` samples
-    /// replaced by its children, as [`Walker::starts`] replaces them (the
-    /// output is the same, in the same order), until none is or none can be.
-    pub(super) fn split_starts(
-        &self,
-        mut starts: Vec<Start<S::Tile>>,
-        most: f64,
-    ) -> Vec<Start<S::Tile>> {
-        loop {
-            let before = starts.len();
-            let mut next = Vec::with_capacity(before);
-            for start in starts {
-                if self.expected(&start) <= most || !self.recurses_into_all(&start.tile) {
-                    next.push(start);
-                    continue;
-                }
-                let count = self.system.child_count(&start.tile);
-                next.extend((0..count).map(|i| Start {
-                    tile: self.system.child(&start.tile, i),
-                    share: start.share / count as f64,
-                }));
-            }
-            starts = next;
-            if starts.len() == before {
-                return starts;
-            }
-        }
+            .unwrap_or_else(|| self.density.average(&self.system.region(tile)));
+        self.scaled(average) / self.capacities[self.system.level(tile) as usize]
     }
 
     /// Whether [`Walker::visit`] of a tile not terminal by its parent visits
@@ -507,7 +480,7 @@ mod tests {
                 let starts = walker.starts(system.roots(), 64);
                 most = most.max(starts.len());
                 for start in &starts {
-                    walker.visit(&start.tile, f64::INFINITY, &mut by_starts);
+                    walker.visit(start, f64::INFINITY, &mut by_starts);
                 }
                 assert!(!by_roots.is_empty());
                 assert_eq!(by_roots, by_starts, "magnitude {magnitude}");
