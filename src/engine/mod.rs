@@ -55,9 +55,9 @@
 //! counting sort orders the samples by rank (ties in root order), or, for
 //! [`Order::Unsorted`], finds only which to keep.
 
+mod batches;
 mod ranking;
 mod stream;
-mod unsorted;
 mod walker;
 
 use crate::density::{Density, Region};
@@ -65,9 +65,9 @@ use crate::memory;
 pub use crate::sample::Sample;
 use crate::tiling::TileSystem;
 use crate::Error;
+pub use batches::{unsorted, Unsorted};
 use ranking::{by_rank, smallest_ranks, RankBuckets};
 pub use stream::{stream, Stream};
-pub use unsorted::{unsorted, Unsorted};
 use walker::collect_parts;
 
 /// Every sample the tiling accepts when `magnitude` samples are expected
@@ -364,6 +364,16 @@ where
             return Ok(out);
         }
     }
+    if order == Order::Progressive && count > PROGRESSIVE_IN_BATCHES_ABOVE {
+        match batches::progressive_in_batches(system, density, count, exact, out) {
+            Ok(true) => return Ok(out),
+            Ok(false) => {}
+            Err(e) => {
+                out.clear();
+                return Err(e);
+            }
+        }
+    }
     let mut magnitude = first_magnitude(count, exact);
     // ranks are counted as each root finishes, for the ranking
     let mut collect = |magnitude: f64, parts: &mut Vec<_>| {
@@ -404,6 +414,17 @@ fn first_magnitude(count: usize, exact: bool) -> f64 {
         false => count as f64,
     }
 }
+
+/// Progressive requests of a varying density larger than this are
+/// computed a batch of subtrees at a time and scattered into their rank
+/// groups (see `batches::progressive_in_batches`): about 34 bytes a
+/// sample at their peak instead of 64, for a second pass over the
+/// recursion. Measured whole-process at 10^7 samples (one run each on a
+/// loaded 2-core machine, user + system CPU): a sphere cap 3.3 s in
+/// batches against 3.2 s in one pass (half of it page faults), 340 MB
+/// against 638 MB; a G-hexomino ramp 1.3 s against 0.6 s, 256 MB against
+/// 480 MB. Below this count the one pass is faster and its memory small.
+const PROGRESSIVE_IN_BATCHES_ABOVE: usize = 1 << 22;
 
 /// Rounds of the search for an exact request's magnitude.
 const MAGNITUDE_ROUNDS: usize = 40;

@@ -112,7 +112,10 @@ pub(super) fn by_rank<P: Copy + Send + Sync>(
 ) {
     let n: usize = parts.iter().map(Vec::len).sum();
     if in_range && n < u32::MAX as usize {
-        sort_by_groups(parts, histograms, n, keep, out);
+        let (buckets, histograms) = histograms;
+        let totals = buckets.total(histograms);
+        let feed = |scatter: &mut Scatter<'_, P>| parts.iter().for_each(|p| scatter(p));
+        sort_fed(feed, (buckets, &totals), keep, out);
         return;
     }
     // (rank as an unsigned key ordered like `f64::total_cmp`, position in
@@ -128,46 +131,61 @@ pub(super) fn by_rank<P: Copy + Send + Sync>(
     keys.truncate(keep);
     out.par_extend(keys.par_iter().map(|&(_, i)| samples[i]));
 }
-/// [`by_rank`] for the `n` samples of `parts` when their ranks lie in
-/// `[0, 1)` (the engine's ranks: `code / d` with `code + 1/2 < d`): a
-/// counting sort in two passes that keep writes in cache. The histograms'
-/// buckets are groups of about 2048 samples: one pass streams each sample
-/// into its group's place in `out`, then each group is sorted within
-/// itself. Groups past the `keep`-th sample are skipped.
-pub(super) fn sort_by_groups<P: Copy + Send + Sync>(
-    parts: &[Vec<Sample<P>>],
-    (buckets, histograms): (RankBuckets, &[Vec<u32>]),
-    n: usize,
+/// Takes samples a slice at a time (see [`sort_fed`]).
+pub(super) type Scatter<'s, P> = dyn FnMut(&[Sample<P>]) + 's;
+
+/// [`by_rank`] for samples whose ranks lie in `[0, 1)` (the engine's
+/// ranks: `code / d` with `code + 1/2 < d`), fewer than `u32::MAX`, that
+/// `feed` hands over a slice at a time, in order, `totals` their counts
+/// per bucket: a counting sort in two passes that keep writes in cache.
+/// The buckets are groups of about 2048 samples: one pass streams each
+/// sample into its group's place in `out`, then each group is sorted
+/// within itself. Groups past the `keep`-th sample are skipped.
+pub(super) fn sort_fed<P: Copy + Send + Sync>(
+    feed: impl FnOnce(&mut Scatter<'_, P>),
+    (buckets, totals): (RankBuckets, &[usize]),
     keep: usize,
     out: &mut Vec<Sample<P>>,
 ) {
-    let Some(&first) = parts.iter().flatten().next() else {
-        out.clear();
-        return;
-    };
-    let groups = buckets.count;
+    let (n, groups) = (totals.iter().sum::<usize>(), buckets.count);
     let mut start = vec![0usize; groups + 1];
-    start[1..].copy_from_slice(&buckets.total(histograms));
+    for (g, &total) in totals.iter().enumerate() {
+        start[g + 1] = total;
+    }
     for g in 0..groups {
         start[g + 1] += start[g];
     }
     // the groups holding the `keep` smallest ranks
     let used = start.partition_point(|&end| end < keep.min(n)).min(groups);
     let ends: Vec<usize> = start[1..=used].to_vec();
-    // (every slot is written below: only new memory needs a fill)
-    if out.capacity() < start[used] {
-        out.clear();
-        let _ = memory::try_reserve_large(out, start[used]);
-    }
-    out.truncate(start[used]);
-    out.resize(start[used], first);
-    // `start[g]` moves to the end of group g while filling
-    for s in parts.iter().flatten() {
-        let g = buckets.of(s.rank);
-        if g < used {
-            out[start[g]] = *s;
-            start[g] += 1;
+    let mut filled = false;
+    let mut scatter = |samples: &[Sample<P>]| {
+        let Some(&first) = samples.first() else {
+            return;
+        };
+        if !filled {
+            // (every slot is written below: only new memory needs a fill)
+            filled = true;
+            if out.capacity() < start[used] {
+                out.clear();
+                let _ = memory::try_reserve_large(out, start[used]);
+            }
+            out.truncate(start[used]);
+            out.resize(start[used], first);
         }
+        // `start[g]` moves to the end of group g while filling
+        for s in samples {
+            let g = buckets.of(s.rank);
+            if g < used {
+                out[start[g]] = *s;
+                start[g] += 1;
+            }
+        }
+    };
+    feed(&mut scatter);
+    if !filled {
+        out.clear();
+        return;
     }
     let mut slices = Vec::with_capacity(used);
     let mut rest = &mut out[..];

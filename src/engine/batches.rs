@@ -1,8 +1,11 @@
-//! A request's samples in [`Order::Unsorted`](super::Order::Unsorted),
-//! written as they are computed: memory for a batch of the recursion's
-//! subtrees however many samples are drawn, at the cost of a second pass.
+//! Requests of a varying density computed a batch of the recursion's
+//! subtrees at a time, after a first pass that counts each subtree's
+//! samples per rank bucket: [`unsorted`] writes them as they come, in
+//! memory for a batch however many are drawn, and large progressive
+//! requests scatter them into their rank groups without first keeping
+//! every subtree's samples (`progressive_in_batches`).
 
-use super::ranking::RankBuckets;
+use super::ranking::{sort_fed, RankBuckets, Scatter};
 use super::walker::Walker;
 use super::{stream, Sample, Stream};
 use crate::density::{Density, Region};
@@ -59,23 +62,44 @@ where
     if let Some(codes) = density.constant().and_then(|_| stream(system, count)) {
         return Ok(Unsorted(Inner::Codes(Some(codes))));
     }
-    // the magnitude search of `generate_into`, counting instead of keeping
-    let mut magnitude = super::first_magnitude(count, exact);
-    let mut counted = Counted::new(system, density, magnitude);
-    for _ in 0..super::MAGNITUDE_ROUNDS {
-        let found = counted.found();
-        if !exact || found >= count {
-            break;
-        }
-        magnitude *= super::growth(count, found);
-        counted = Counted::new(system, density, magnitude);
-    }
-    let found = counted.found();
-    if exact && found < count {
-        return Err(super::too_few(found, count));
-    }
+    let counted = Counted::search(system, density, count, exact)?;
     let keep = if exact { count } else { usize::MAX };
     Ok(Unsorted(Inner::Walk(Box::new(Walk::new(counted, keep)))))
+}
+
+/// [`generate_into`](super::generate_into)'s progressive samples of a
+/// varying density, computed as [`unsorted`]'s are, a batch at a time, and
+/// scattered into their rank groups in `out` as they come: the output's 32
+/// bytes (sphere) a sample and a batch, where keeping every subtree's
+/// samples before ranking them takes twice that. False, with `out` left
+/// as it was, where the ranks do not suit the counting sort (never the
+/// engine's).
+pub(super) fn progressive_in_batches<S, D>(
+    system: &S,
+    density: &D,
+    count: usize,
+    exact: bool,
+    out: &mut Vec<Sample<S::Point>>,
+) -> Result<bool, Error>
+where
+    S: TileSystem,
+    S::Region: Region<Point = S::Point>,
+    D: Density<S::Region> + ?Sized,
+{
+    let counted = Counted::search(system, density, count, exact)?;
+    if !counted.in_range || counted.found() >= u32::MAX as usize {
+        return Ok(false);
+    }
+    let keep = if exact { count } else { usize::MAX };
+    let mut lists = Vec::new();
+    let feed = |scatter: &mut Scatter<'_, S::Point>| {
+        for (batch, size) in runs(&counted.sizes, BATCH_SAMPLES) {
+            counted.visit(batch, size, &mut lists);
+            lists.iter().for_each(|list| scatter(list));
+        }
+    };
+    sort_fed(feed, (counted.buckets, &counted.counts), keep, out);
+    Ok(true)
 }
 
 /// The samples of [`unsorted`], an exact-size iterator.
@@ -135,6 +159,8 @@ struct Counted<'a, S: TileSystem, D: ?Sized> {
     starts: Vec<S::Tile>,
     /// The samples of each start's subtree.
     sizes: Vec<usize>,
+    /// Whether every rank lay in `[0, 1)` (always the engine's).
+    in_range: bool,
     buckets: RankBuckets,
     counts: Vec<usize>,
 }
@@ -150,34 +176,35 @@ where
         let big = |tile: &S::Tile| walker.expected(tile) > SUBTREE_SAMPLES;
         let starts = walker.split(system.roots(), |_| true, big);
         let buckets = RankBuckets::for_magnitude(magnitude);
-        let add = |mut a: Vec<usize>, b: Vec<usize>| {
-            a.resize(a.len().max(b.len()), 0);
+        let add = |mut a: Vec<usize>, b: &[usize]| {
+            a.resize(buckets.count, 0);
             a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
             a
         };
-        // per thread: the counts per bucket, each start's size, and the
-        // lists a start is visited into (memory reused)
-        let (counts, sized) = starts
+        // per thread: the counts per bucket, each start's size, whether
+        // every rank lay in [0, 1), and the lists a start is visited into
+        // (memory reused)
+        let (counts, sized, in_range) = starts
             .par_iter()
             .enumerate()
             .fold(
-                || (Vec::new(), Vec::new(), Vec::new(), Vec::new()),
-                |(totals, mut sized, mut samples, mut counts), (k, start)| {
+                || (Vec::new(), Vec::new(), true, Vec::new(), Vec::new()),
+                |(totals, mut sized, in_range, mut samples, mut counts), (k, start)| {
                     samples.clear();
                     counts.clear();
                     walker.visit(start, f64::INFINITY, &mut samples);
-                    buckets.count_into(&samples, &mut counts);
+                    let in_range = buckets.count_into(&samples, &mut counts) && in_range;
                     sized.push((k, samples.len()));
-                    let totals = add(totals, counts.iter().map(|&c| c as usize).collect());
-                    (totals, sized, samples, counts)
+                    let counts_now: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+                    (add(totals, &counts_now), sized, in_range, samples, counts)
                 },
             )
-            .map(|(totals, sized, _, _)| (totals, sized))
+            .map(|(totals, sized, in_range, _, _)| (totals, sized, in_range))
             .reduce(
-                || (Vec::new(), Vec::new()),
-                |(a, mut sized), (b, more)| {
+                || (Vec::new(), Vec::new(), true),
+                |(a, mut sized, a_in), (b, more, b_in)| {
                     sized.extend(more);
-                    (add(a, b), sized)
+                    (add(a, &b), sized, a_in && b_in)
                 },
             );
         let mut sizes = vec![0; starts.len()];
@@ -189,12 +216,54 @@ where
             starts,
             sizes,
             buckets,
-            counts,
+            counts: add(counts, &[]),
+            in_range,
         }
+    }
+
+    /// The magnitude search of `generate_into`, counting instead of
+    /// keeping.
+    fn search(system: &'a S, density: &'a D, count: usize, exact: bool) -> Result<Self, Error> {
+        let mut magnitude = super::first_magnitude(count, exact);
+        let mut counted = Counted::new(system, density, magnitude);
+        for _ in 0..super::MAGNITUDE_ROUNDS {
+            let found = counted.found();
+            if !exact || found >= count {
+                break;
+            }
+            magnitude *= super::growth(count, found);
+            counted = Counted::new(system, density, magnitude);
+        }
+        let found = counted.found();
+        if exact && found < count {
+            return Err(super::too_few(found, count));
+        }
+        Ok(counted)
     }
 
     fn found(&self) -> usize {
         self.sizes.iter().sum()
+    }
+
+    /// The samples of the subtrees `batch` (`size` of them), into `lists`,
+    /// in order, a run of subtrees a thread.
+    fn visit(&self, batch: Range<usize>, size: usize, lists: &mut Vec<Vec<Sample<S::Point>>>) {
+        let (starts, sizes) = (&self.starts[batch.clone()], &self.sizes[batch]);
+        // about a thread's share of the samples each
+        let share = size.div_ceil(rayon::current_num_threads()).max(1);
+        let runs = runs(sizes, share);
+        lists.resize_with(runs.len(), Vec::new);
+        lists.truncate(runs.len());
+        lists
+            .par_iter_mut()
+            .zip(&runs)
+            .for_each(|(list, (run, size))| {
+                list.clear();
+                list.reserve_exact(*size);
+                for start in &starts[run.clone()] {
+                    self.walker.visit(start, f64::INFINITY, list);
+                }
+            });
     }
 }
 
@@ -277,30 +346,11 @@ where
         }
     }
 
-    /// Computes the next batch's subtrees into `lists`, a run of them a
-    /// thread.
+    /// Computes the next batch's subtrees into `lists`.
     fn compute_batch(&mut self) {
         let (batch, size) = self.batches[self.next_batch].clone();
         self.next_batch += 1;
-        let walker = &self.counted.walker;
-        let (starts, sizes) = (
-            &self.counted.starts[batch.clone()],
-            &self.counted.sizes[batch],
-        );
-        // about a thread's share of the samples each
-        let share = size.div_ceil(rayon::current_num_threads()).max(1);
-        let runs = runs(sizes, share);
-        self.lists.resize_with(runs.len(), Vec::new);
-        self.lists
-            .par_iter_mut()
-            .zip(&runs)
-            .for_each(|(list, (run, size))| {
-                list.clear();
-                list.reserve_exact(*size);
-                for start in &starts[run.clone()] {
-                    walker.visit(start, f64::INFINITY, list);
-                }
-            });
+        self.counted.visit(batch, size, &mut self.lists);
         self.at = (0, 0);
     }
 
@@ -356,5 +406,50 @@ where
                 return None;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::density::plane::Ramp;
+    use crate::density::sphere::Cap;
+    use crate::engine::{generate_into, Buffers, Order};
+    use crate::tiling::penrose::PenroseTiling;
+    use crate::tiling::plane::PlaneTiling;
+    use crate::tiling::sphere::SphereTiling;
+
+    /// The progressive path in batches gives what the one-pass path gives
+    /// (below the count where `generate_into` switches to it), exact and
+    /// not, across batches.
+    #[test]
+    fn progressive_in_batches_equals_one_pass() {
+        fn check<S, D>(system: &S, density: &D, count: usize, exact: bool)
+        where
+            S: TileSystem,
+            S::Region: Region<Point = S::Point>,
+            S::Point: PartialEq + std::fmt::Debug,
+            D: Density<S::Region> + ?Sized,
+        {
+            let mut buffers = Buffers::default();
+            let one_pass = generate_into(
+                system,
+                density,
+                count,
+                exact,
+                Order::Progressive,
+                &mut buffers,
+            )
+            .unwrap();
+            let mut batched = Vec::new();
+            assert!(progressive_in_batches(system, density, count, exact, &mut batched).unwrap());
+            assert!(batched == one_pass, "{count} {exact}");
+        }
+        let cap = Cap::new(10.0, 20.0, 30.0, 10.0).unwrap();
+        for (count, exact) in [(1, true), (2000, true), (1_300_000, true), (200_000, false)] {
+            check(&PlaneTiling::ghexomino(), &Ramp, count, exact);
+            check(&SphereTiling::default(), &cap, count, exact);
+        }
+        check(&PenroseTiling::default(), &Ramp, 600_000, true);
     }
 }
