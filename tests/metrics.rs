@@ -697,6 +697,20 @@ fn nearest_neighbour_distances_match_brute_force() {
         assert_relative_eq!(min_distance(&p), min / h, max_relative = 1e-12);
         assert_relative_eq!(mean_nn_distance(&p), mean / h, max_relative = 1e-12);
     }
+    // Sets whose bounding box is flat or a point (the k-d tree pass visits
+    // points in Morton order over that box): a vertical line, duplicates.
+    let line: Vec<DVec2> = (0..300)
+        .map(|i| DVec2::new(0.5, ((i * 37) % 300) as f64 / 300.0))
+        .collect();
+    let same = vec![DVec2::splat(0.25); 5];
+    for p in [line, same] {
+        let d = brute_nn(&p);
+        let h = hex_spacing(p.len());
+        let min = d.iter().copied().fold(f64::INFINITY, f64::min);
+        let mean = d.iter().sum::<f64>() / p.len() as f64;
+        assert_eq!(min_distance(&p), min / h);
+        assert_relative_eq!(mean_nn_distance(&p), mean / h, max_relative = 1e-12);
+    }
     // A hexagonal lattice patch has min distance = its spacing.
     let s = 0.05;
     let mut hex = Vec::new();
