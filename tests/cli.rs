@@ -750,3 +750,52 @@ fn a_rebuilt_table_is_used_without_recompiling() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `lights --table FILE` draws the directions with a table read at run
+/// time: the tracked `luts/sphere.lut` (the one built in) gives the
+/// built-in lights, another table other lights, and a table of another
+/// system is refused naming the file.
+#[test]
+fn lights_take_a_table_at_run_time() {
+    let dir = std::env::temp_dir().join(format!("tessera-lights-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let map = dir.join("sky.exr");
+    tessera::synth::Sky::Overcast
+        .generate(64, 32, 1)
+        .write_exr(&map, false)
+        .unwrap();
+    // every offset at the tile's centre: a valid table, not the shipped one
+    let mut centred = (*tessera::lut::sphere_lut()).clone();
+    for table in &mut centred.tables {
+        table.fill([0, 0]);
+    }
+    let other = dir.join("centred.lut");
+    std::fs::write(&other, centred.to_bytes()).unwrap();
+    let repo = env!("CARGO_MANIFEST_DIR");
+    let lights = |table: Option<&str>| {
+        let mut args = vec!["lights", "--map", map.to_str().unwrap(), "-n", "64"];
+        if let Some(t) = table {
+            args.extend(["--table", t]);
+        }
+        stdout(&args)
+    };
+    let built_in = lights(None);
+    let shipped = format!("{repo}/luts/sphere.lut");
+    assert_eq!(lights(Some(&shipped)), built_in);
+    assert_ne!(lights(Some(other.to_str().unwrap())), built_in);
+    let planar = format!("{repo}/luts/ppentomino.lut");
+    let args = [
+        "lights",
+        "--map",
+        map.to_str().unwrap(),
+        "-n",
+        "8",
+        "--table",
+        &planar,
+    ];
+    let out = tessera(&args);
+    assert_eq!(out.status.code(), Some(1), "{args:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("ppentomino.lut: not a sphere table"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
