@@ -244,7 +244,10 @@ fn plot_and_metrics_png() {
         &path("ap.png"),
     ]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    assert_eq!(v["angular_power"].as_array().unwrap().len(), 65);
+    // l = 0..=3 sqrt(N) (68 for N = 500)
+    let degrees = tessera::metrics::sphere::spectrum_degree(500);
+    assert_eq!(degrees, 68);
+    assert_eq!(v["angular_power"].as_array().unwrap().len(), degrees + 1);
     for (name, size) in [
         ("eq.png", (200, 100)),
         ("o.png", (120, 120)),
