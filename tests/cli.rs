@@ -802,3 +802,48 @@ fn lights_take_a_table_at_run_time() {
     assert!(err.contains("ppentomino.lut: not a sphere table"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--strict` on the command line passes the negative pixels a lossy
+/// codec leaves (a generated sky written as f16 DWAB, which the lenient
+/// read counts and zeroes with a warning) and refuses real damage, naming
+/// the file, with exit code 1.
+#[test]
+fn strict_passes_compression_noise_and_refuses_damage() {
+    use tessera::io::image::{read_raster, ReadOptions};
+    let dir = std::env::temp_dir().join(format!("tessera-strict-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let noisy = tessera::synth::Sky::all()
+        .into_iter()
+        .find_map(|sky| {
+            let path = dir.join(format!("{}.exr", sky.name()));
+            sky.generate(256, 128, 1).write_exr(&path, true).unwrap();
+            let read = read_raster(&path, &ReadOptions::default()).unwrap();
+            (read.bad_pixels > 0).then_some(path)
+        })
+        .expect("the codec leaves negative pixels in some generated sky");
+    let noisy = noisy.to_str().unwrap();
+    let lenient = tessera(&["sphere", "--map", noisy, "-n", "100", "-o", "-"]);
+    assert!(lenient.status.success());
+    let warning = String::from_utf8_lossy(&lenient.stderr);
+    assert!(
+        warning.contains(noisy) && warning.contains("warning"),
+        "{warning}"
+    );
+    let strict = stdout(&["sphere", "--map", noisy, "-n", "100", "--strict"]);
+    assert_eq!(strict, String::from_utf8(lenient.stdout).unwrap());
+    let mut map = tessera::synth::Sky::Overcast.generate(64, 32, 1);
+    map.rgb[20 * 64 + 10] = [-0.5, -0.5, -0.5];
+    let damaged = dir.join("damaged.exr");
+    map.write_exr(&damaged, false).unwrap();
+    let damaged = damaged.to_str().unwrap();
+    for command in ["sphere", "lights"] {
+        let out = tessera(&[command, "--map", damaged, "-n", "10", "--strict"]);
+        assert_eq!(out.status.code(), Some(1), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(damaged) && err.contains("beyond codec noise"),
+            "{err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
