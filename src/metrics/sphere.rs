@@ -404,9 +404,10 @@ const BIG: f64 = 1.157_920_892_373_162e77;
 /// sectoral `Q_mm = sqrt((2m−1)/(2m)) sin θ Q_{m−1,m−1}` by
 /// `Q_lm = ((2l−1) z Q_{l−1,m} − sqrt((l−1)²−m²) Q_{l−2,m}) / sqrt(l²−m²)`.
 /// Normalised functions are at most 1 in magnitude, so nothing overflows
-/// (the unnormalised `P_lm` reach `(2l−1)!!`, past f64 at l = 150). They
-/// can underflow: `Q_mm ~ sin^m θ` is below 1e-308 within 31° of a pole
-/// at m = 1024, while `Q_lm` for larger `l` grows back to matter. So the
+/// (the unnormalised `P_ll` is `(2l−1)!! sin^l θ`, and `(2l−1)!!` passes
+/// f64 at l = 151). They can underflow: `Q_mm ~ sin^m θ` is below 1e-308
+/// within 30° of a pole at m = 1024, while `Q_lm` for larger `l` grows
+/// back to matter. So the
 /// sectoral value is kept as a mantissa times `BIG^−e`, and a point whose
 /// `e > 0` is recurred silently (scaled, rescaled by `BIG` whenever it
 /// passes 1) until `e` reaches 0; it is added from that degree on, and
