@@ -21,8 +21,9 @@ pub(crate) struct MetricsArgs {
     #[arg(long, value_name = "KEY,...")]
     only: Option<String>,
     /// Also print the spectrum: `angular_power`, P(l) for l = 0..3 sqrt(N)
-    /// (sphere; at least 64, at most 1024, and lower where N (l + 1)^2 / 2
-    /// would pass 3x10^10 steps, above about N = 82000), or `radial_power`
+    /// (sphere; at least 64, at most 1024, and lower where
+    /// N (l + 1)(l + 2) / 2 would pass 3x10^10 steps, above about
+    /// N = 82000), or `radial_power`
     /// and `anisotropy_db` per ring (plane; out to twice the blue-noise
     /// peak, of a corner window holding 20000 points above that many).
     #[arg(long)]
