@@ -12,8 +12,28 @@
 //! let points = Sampler::sphere().density(cap).count(500).generate().unwrap();
 //! assert_eq!(points.len(), 500);
 //! ```
+//!
+//! # Features
+//!
+//! All on by default. With `default-features = false` the library keeps the
+//! samplers (sphere, plane, Penrose, polyominoes), densities (caps, polygons,
+//! environment maps and HEALPix maps from arrays in memory, HEALPix FITS
+//! files), relaxation, lights, metrics, tables and point files, and builds
+//! none of these:
+//!
+//! - `cli`: the `tessera` command line (clap, indicatif); turns on the rest.
+//! - `exr`: OpenEXR maps in [`io::image`] and `synth::SynthMap::write_exr`.
+//! - `image`: PNG and Radiance `.hdr` maps in [`io::image`], and the PNG
+//!   pictures of `plot`.
+//! - `baselines`: the samplers tessera is compared with (`baselines`), and
+//!   with `image` the accuracy study (`accuracy`).
+//!
+//! A file whose format needs a feature left out is refused with an error
+//! naming the file and the feature.
 
+#[cfg(all(feature = "baselines", feature = "image"))]
 pub mod accuracy;
+#[cfg(feature = "baselines")]
 pub mod baselines;
 pub mod density;
 pub mod engine;
@@ -25,6 +45,7 @@ pub mod lut;
 mod memory;
 pub mod metrics;
 pub mod optimize;
+#[cfg(feature = "image")]
 pub mod plot;
 pub mod polyomino;
 pub mod random;

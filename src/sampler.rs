@@ -237,8 +237,25 @@ impl EnvMap {
     /// assert_eq!(map.generate(100).unwrap().len(), 100);
     /// ```
     pub fn generate(&self, count: usize) -> Result<Vec<Sample<DVec3>>, Error> {
-        let tiling = SphereTiling::default();
-        let mut samples = engine::generate(&tiling, self, count, true)?;
+        self.generate_with(&SphereTiling::default(), count)
+    }
+
+    /// [`EnvMap::generate`] with the sphere tiling `tiling` (for instance
+    /// one driven by a table read at run time, [`crate::lut::Table::open`]).
+    ///
+    /// # Example
+    /// ```
+    /// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, tiling::sphere::SphereTiling};
+    /// let map = EnvMap::new(Raster { width: 2, height: 1, values: vec![1.0, 3.0], bad_pixels: 0 }, Up::Z).unwrap();
+    /// let tiling = SphereTiling::new(tessera::lut::sphere_lut());
+    /// assert_eq!(map.generate_with(&tiling, 100).unwrap(), map.generate(100).unwrap());
+    /// ```
+    pub fn generate_with(
+        &self,
+        tiling: &SphereTiling,
+        count: usize,
+    ) -> Result<Vec<Sample<DVec3>>, Error> {
+        let mut samples = engine::generate(tiling, self, count, true)?;
         if self.seed().is_some() {
             for s in &mut samples {
                 s.position = self.to_world(s.position);

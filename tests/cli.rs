@@ -244,7 +244,10 @@ fn plot_and_metrics_png() {
         &path("ap.png"),
     ]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    assert_eq!(v["angular_power"].as_array().unwrap().len(), 65);
+    // l = 0..=3 sqrt(N) (68 for N = 500)
+    let degrees = tessera::metrics::sphere::spectrum_degree(500);
+    assert_eq!(degrees, 68);
+    assert_eq!(v["angular_power"].as_array().unwrap().len(), degrees + 1);
     for (name, size) in [
         ("eq.png", (200, 100)),
         ("o.png", (120, 120)),
@@ -747,6 +750,100 @@ fn a_rebuilt_table_is_used_without_recompiling() {
         assert_eq!(out.status.code(), Some(1), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains("ppentomino.lut: not a"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `lights --table FILE` draws the directions with a table read at run
+/// time: the tracked `luts/sphere.lut` (the one built in) gives the
+/// built-in lights, another table other lights, and a table of another
+/// system is refused naming the file.
+#[test]
+fn lights_take_a_table_at_run_time() {
+    let dir = std::env::temp_dir().join(format!("tessera-lights-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let map = dir.join("sky.exr");
+    tessera::synth::Sky::Overcast
+        .generate(64, 32, 1)
+        .write_exr(&map, false)
+        .unwrap();
+    // every offset at the tile's centre: a valid table, not the shipped one
+    let mut centred = (*tessera::lut::sphere_lut()).clone();
+    for table in &mut centred.tables {
+        table.fill([0, 0]);
+    }
+    let other = dir.join("centred.lut");
+    std::fs::write(&other, centred.to_bytes()).unwrap();
+    let repo = env!("CARGO_MANIFEST_DIR");
+    let lights = |table: Option<&str>| {
+        let mut args = vec!["lights", "--map", map.to_str().unwrap(), "-n", "64"];
+        if let Some(t) = table {
+            args.extend(["--table", t]);
+        }
+        stdout(&args)
+    };
+    let built_in = lights(None);
+    let shipped = format!("{repo}/luts/sphere.lut");
+    assert_eq!(lights(Some(&shipped)), built_in);
+    assert_ne!(lights(Some(other.to_str().unwrap())), built_in);
+    let planar = format!("{repo}/luts/ppentomino.lut");
+    let args = [
+        "lights",
+        "--map",
+        map.to_str().unwrap(),
+        "-n",
+        "8",
+        "--table",
+        &planar,
+    ];
+    let out = tessera(&args);
+    assert_eq!(out.status.code(), Some(1), "{args:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("ppentomino.lut: not a sphere table"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `--strict` on the command line passes the negative pixels a lossy
+/// codec leaves (a generated sky written as f16 DWAB, which the lenient
+/// read counts and zeroes with a warning) and refuses real damage, naming
+/// the file, with exit code 1.
+#[test]
+fn strict_passes_compression_noise_and_refuses_damage() {
+    use tessera::io::image::{read_raster, ReadOptions};
+    let dir = std::env::temp_dir().join(format!("tessera-strict-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let noisy = tessera::synth::Sky::all()
+        .into_iter()
+        .find_map(|sky| {
+            let path = dir.join(format!("{}.exr", sky.name()));
+            sky.generate(256, 128, 1).write_exr(&path, true).unwrap();
+            let read = read_raster(&path, &ReadOptions::default()).unwrap();
+            (read.bad_pixels > 0).then_some(path)
+        })
+        .expect("the codec leaves negative pixels in some generated sky");
+    let noisy = noisy.to_str().unwrap();
+    let lenient = tessera(&["sphere", "--map", noisy, "-n", "100", "-o", "-"]);
+    assert!(lenient.status.success());
+    let warning = String::from_utf8_lossy(&lenient.stderr);
+    assert!(
+        warning.contains(noisy) && warning.contains("warning"),
+        "{warning}"
+    );
+    let strict = stdout(&["sphere", "--map", noisy, "-n", "100", "--strict"]);
+    assert_eq!(strict, String::from_utf8(lenient.stdout).unwrap());
+    let mut map = tessera::synth::Sky::Overcast.generate(64, 32, 1);
+    map.rgb[20 * 64 + 10] = [-0.5, -0.5, -0.5];
+    let damaged = dir.join("damaged.exr");
+    map.write_exr(&damaged, false).unwrap();
+    let damaged = damaged.to_str().unwrap();
+    for command in ["sphere", "lights"] {
+        let out = tessera(&[command, "--map", damaged, "-n", "10", "--strict"]);
+        assert_eq!(out.status.code(), Some(1), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(damaged) && err.contains("beyond codec noise"),
+            "{err}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -8,6 +8,11 @@
 //! set to 0 (or refused with [`ReadOptions::strict`]); a file with nothing
 //! positive is an error naming it. No input makes the reader panic.
 //!
+//! Each decoder is behind the feature that builds its crate (`exr`;
+//! `image` for PNG and `.hdr`), both in the default features. Without one,
+//! a file of its format is refused with an error naming the file and the
+//! feature; [`Raster::from_values`] takes pixels from memory either way.
+//!
 //! ```
 //! use tessera::io::image::{read_raster, ReadOptions};
 //! let err = read_raster("no/such/map.exr".as_ref(), &ReadOptions::default()).unwrap_err();
@@ -16,6 +21,52 @@
 
 use crate::Error;
 use std::path::Path;
+
+#[cfg(feature = "exr")]
+pub(crate) mod openexr;
+#[cfg(feature = "image")]
+mod png_hdr;
+
+/// Stands in for the OpenEXR codec in a build without the `exr` feature.
+#[cfg(not(feature = "exr"))]
+pub(crate) mod openexr {
+    use super::{missing, Decoded};
+    use std::path::Path;
+
+    pub(super) fn read(_: &Path) -> Result<Decoded, String> {
+        Err(missing("an OpenEXR file", "exr"))
+    }
+
+    pub(crate) fn write_rgb(
+        _: &Path,
+        _: usize,
+        _: usize,
+        _: &[[f32; 3]],
+        _: bool,
+    ) -> Result<(), String> {
+        Err(missing("OpenEXR output", "exr"))
+    }
+}
+
+/// Stands in for the PNG and `.hdr` decoder in a build without the `image`
+/// feature.
+#[cfg(not(feature = "image"))]
+mod png_hdr {
+    use super::{missing, Decoded};
+    use std::path::Path;
+
+    pub(super) fn read(_: &Path) -> Result<Decoded, String> {
+        Err(missing("a PNG or Radiance .hdr file", "image"))
+    }
+}
+
+/// The reason given for a format whose codec this build left out.
+#[cfg(not(all(feature = "exr", feature = "image")))]
+fn missing(what: &str, feature: &str) -> String {
+    format!(
+        "{what}, which this build of tessera cannot read or write: it needs the `{feature}` feature (on by default)"
+    )
+}
 
 /// Largest raster read (pixels): refuses headers that would allocate
 /// gigabytes before any pixel is decoded.
@@ -274,9 +325,9 @@ impl Decoded {
                 .map_err(fail)
         };
         if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            guarded(&|| read_exr(path))
+            guarded(&|| openexr::read(path))
         } else if head.starts_with(b"#?") || head.starts_with(b"\x89PNG") {
-            guarded(&|| read_with_image_crate(path))
+            guarded(&|| png_hdr::read(path))
         } else if head.is_empty() {
             Err(fail("the file is empty".into()))
         } else {
@@ -384,53 +435,9 @@ fn srgb_to_linear(v: f64) -> f64 {
     }
 }
 
-fn read_exr(path: &Path) -> Result<Decoded, String> {
-    use exr::prelude::*;
-    // the header first: refuse absurd sizes before allocating for them
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
-    let header = meta
-        .headers
-        .iter()
-        .find(|h| !h.deep)
-        .ok_or("the file holds only deep data, which has no per-pixel value")?;
-    let (w, h) = (header.layer_size.width(), header.layer_size.height());
-    check_size(w, h)?;
-    let reader = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes();
-    // decode on the caller's threads: one thread asked, one thread used
-    let image = if rayon::current_num_threads() == 1 {
-        reader.non_parallel().from_file(path)
-    } else {
-        reader.from_file(path)
-    }
-    .map_err(|e| e.to_string())?;
-    let layer = image.layer_data;
-    let (w, h) = (layer.size.width(), layer.size.height());
-    check_size(w, h)?;
-    let mut channels = Vec::new();
-    for c in layer.channel_data.list {
-        let name = c.name.to_string();
-        if c.sample_data.len() != w * h {
-            return Err(format!(
-                "channel '{name}' is subsampled ({} samples for {w}x{h} pixels), which is not supported",
-                c.sample_data.len()
-            ));
-        }
-        let samples = c.sample_data.values_as_f32().collect();
-        channels.push(Channel { name, samples });
-    }
-    Ok(Decoded {
-        width: w,
-        height: h,
-        channels,
-        srgb: false,
-    })
-}
-
+/// Refuses empty images and ones over [`MAX_PIXELS`] (the decoders call it
+/// before they allocate).
+#[cfg(any(feature = "exr", feature = "image"))]
 fn check_size(w: usize, h: usize) -> Result<(), String> {
     if w == 0 || h == 0 {
         return Err(format!("the image is empty ({w}x{h})"));
@@ -443,55 +450,45 @@ fn check_size(w: usize, h: usize) -> Result<(), String> {
     }
 }
 
-fn read_with_image_crate(path: &Path) -> Result<Decoded, String> {
-    let reader = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| e.to_string())?;
-    let image = reader.decode().map_err(|e| e.to_string())?;
-    let (w, h) = (image.width() as usize, image.height() as usize);
-    check_size(w, h)?;
-    let color = image.color();
-    // integer formats hold display (sRGB) values; float formats are linear
-    let srgb = !matches!(color, image::ColorType::Rgb32F | image::ColorType::Rgba32F);
-    let rgba = image.into_rgba32f().into_raw();
-    let plane = |k: usize| {
-        rgba.iter()
-            .skip(k)
-            .step_by(4)
-            .copied()
-            .collect::<Vec<f32>>()
-    };
-    let mut channels = if color.has_color() {
-        vec![
-            Channel {
-                name: "R".into(),
-                samples: plane(0),
-            },
-            Channel {
-                name: "G".into(),
-                samples: plane(1),
-            },
-            Channel {
-                name: "B".into(),
-                samples: plane(2),
-            },
-        ]
-    } else {
-        vec![Channel {
-            name: "Y".into(),
-            samples: plane(0),
-        }]
-    };
-    if color.has_alpha() {
-        channels.push(Channel {
-            name: "A".into(),
-            samples: plane(3),
-        });
+/// Run with `cargo test --no-default-features --lib io::image`: the
+/// default build has both codecs.
+#[cfg(all(test, not(all(feature = "exr", feature = "image"))))]
+mod tests {
+    use super::{read_raster, ReadOptions};
+
+    /// A file in a format whose codec was left out is refused with an
+    /// error naming the file and the feature (not a panic, not "unknown
+    /// format").
+    #[test]
+    fn missing_codec_names_file_and_feature() {
+        let dir =
+            std::env::temp_dir().join(format!("tessera-missing-codec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let files: [(&str, &[u8], &str); 3] = [
+            ("a.exr", &[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0], "exr"),
+            ("b.png", b"\x89PNG\r\n\x1a\n", "image"),
+            ("c.hdr", b"#?RADIANCE\n", "image"),
+        ];
+        let built = |feature: &str| match feature {
+            "exr" => cfg!(feature = "exr"),
+            _ => cfg!(feature = "image"),
+        };
+        for (name, bytes, feature) in files.into_iter().filter(|f| !built(f.2)) {
+            let path = dir.join(name);
+            std::fs::write(&path, bytes).unwrap();
+            let e = read_raster(&path, &ReadOptions::default()).unwrap_err();
+            let e = e.to_string();
+            assert!(
+                e.contains(name) && e.contains(&format!("`{feature}` feature")),
+                "{e}"
+            );
+        }
+        let map = crate::synth::Sky::Overcast.generate(8, 4, 1);
+        let written = map.write_exr(&dir.join("d.exr"), false);
+        if !built("exr") {
+            let e = written.unwrap_err().to_string();
+            assert!(e.contains("d.exr") && e.contains("`exr` feature"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
-    Ok(Decoded {
-        width: w,
-        height: h,
-        channels,
-        srgb,
-    })
 }

@@ -51,12 +51,14 @@ mod read;
 use crate::density::envmap::{EnvMap, Up};
 use crate::density::Density;
 use crate::io::image::{Raster, ReadOptions};
-use crate::tiling::sphere::SphereRegion;
+use crate::lut::SphereLut;
+use crate::tiling::sphere::{SphereRegion, SphereTiling};
 use crate::Error;
 use glam::DVec3;
 use std::f64::consts::PI;
 use std::io::Write;
 use std::path::Path;
+use std::sync::Arc;
 
 /// One directional light: a unit direction (world frame) and the power of
 /// its cell.
@@ -250,6 +252,7 @@ pub fn read_rgb(path: &Path, options: &ReadOptions) -> Result<(RgbMap, Raster), 
 /// let o = tessera::lights::LightOptions::default();
 /// assert!(o.rgb.is_none() && o.seed.is_none());
 /// assert!(o.rgb.is_none() && o.exponent.is_none() && o.lloyd_steps == 3);
+/// assert!(o.table.is_none());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightOptions<'a> {
@@ -279,6 +282,9 @@ pub struct LightOptions<'a> {
     /// seed (see [`EnvMap::with_seed`]); without it the lights are
     /// deterministic.
     pub seed: Option<u64>,
+    /// Draw the directions with this sphere table instead of the built-in
+    /// one (a table read at run time, [`crate::lut::Table::open`]).
+    pub table: Option<&'a SphereLut>,
 }
 
 /// The density exponent for `n` lights when none is given, piecewise
@@ -335,6 +341,7 @@ impl Default for LightOptions<'_> {
             lloyd_steps: DEFAULT_LLOYD_STEPS,
             tolerance: DEFAULT_TOLERANCE,
             seed: None,
+            table: None,
         }
     }
 }
@@ -476,7 +483,10 @@ pub fn lights_with_stats(
         Some(seed) => density.with_seed(seed),
         None => density,
     };
-    let drawn = density.generate(n)?;
+    let tiling = options.table.map_or_else(SphereTiling::default, |lut| {
+        SphereTiling::new(Arc::new(lut.clone()))
+    });
+    let drawn = density.generate_with(&tiling, n)?;
     let mut generators: Vec<DVec3> = drawn
         .iter()
         .map(|s| up.to_map(s.position).normalize())

@@ -43,12 +43,58 @@ pub fn hex_spacing(n: usize) -> f64 {
     (2.0 / (3f64.sqrt() * n as f64)).sqrt()
 }
 
-/// Euclidean distance from each point to its nearest other point (N ≥ 2).
+/// The indices of `points` along a Morton (Z-order) curve over their
+/// bounding box (32 bits per axis): points near in the plane are mostly
+/// near in this order, so visiting them in it keeps a k-d tree's nodes in
+/// cache. A progressive file's order jumps across the square at every
+/// point and misses the cache on nearly every query. NaN coordinates key
+/// as the box's low side.
+fn morton_order(points: &[DVec2]) -> Vec<usize> {
+    let (lo, hi) = points
+        .iter()
+        .filter(|p| p.is_finite())
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    // a flat box (or none) keys every point 0 along that axis
+    let extent = hi - lo;
+    let scale = DVec2::select(
+        extent.cmpgt(DVec2::ZERO),
+        u32::MAX as f64 / extent,
+        DVec2::ZERO,
+    );
+    // spreads the 32 bits of a coordinate to the even bits of a u64
+    fn spread(v: f64) -> u64 {
+        let mut x = v as u64 & 0xffff_ffff; // saturating cast: NaN is 0
+        x = (x | x << 16) & 0x0000_ffff_0000_ffff;
+        x = (x | x << 8) & 0x00ff_00ff_00ff_00ff;
+        x = (x | x << 4) & 0x0f0f_0f0f_0f0f_0f0f;
+        x = (x | x << 2) & 0x3333_3333_3333_3333;
+        (x | x << 1) & 0x5555_5555_5555_5555
+    }
+    let mut keyed: Vec<(u64, usize)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let q = (*p - lo) * scale;
+            (spread(q.x) | spread(q.y) << 1, i)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// Euclidean distance from each point to its nearest other point (N ≥ 2),
+/// in [`morton_order`] (the points are visited, and the k-d tree built,
+/// in that order, for cache locality).
 fn nn_distances(points: &[DVec2], progress: Progress) -> Vec<f64> {
-    let coords: Vec<[f64; 2]> = points.iter().map(|p| p.to_array()).collect();
+    let coords: Vec<[f64; 2]> = morton_order(points)
+        .into_par_iter()
+        .map(|i| points[i].to_array())
+        .collect();
     let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&coords);
     let tally = Tally::new("neighbours", points.len() as u64, progress);
-    (0..points.len())
+    (0..coords.len())
         .into_par_iter()
         .map(|i| {
             let found = tree.nearest_n::<SquaredEuclidean>(&coords[i], NonZero::new(2).unwrap());
@@ -58,7 +104,7 @@ fn nn_distances(points: &[DVec2], progress: Progress) -> Vec<f64> {
                 .find(|&j| j != i)
                 .expect("a tree of at least two points returns another point");
             tally.add(1);
-            points[i].distance(points[j])
+            DVec2::from_array(coords[i]).distance(DVec2::from_array(coords[j]))
         })
         .collect()
 }

@@ -105,7 +105,8 @@ impl SynthMap {
     /// in ZIP-compressed scanlines, or with `half` f16 samples in
     /// DWAB-compressed (lossy) 64 x 64 tiles, the two encodings of the
     /// issue's real maps. Values beyond the f16 range are written as
-    /// +-65504 rather than infinity. Errors name the path.
+    /// +-65504 rather than infinity. Errors name the path; without the
+    /// `exr` feature writing is refused with an error naming the feature.
     ///
     /// # Example
     /// ```
@@ -121,7 +122,6 @@ impl SynthMap {
     /// std::fs::remove_dir_all(&dir).unwrap();
     /// ```
     pub fn write_exr(&self, path: &Path, half: bool) -> Result<(), Error> {
-        use exr::prelude::*;
         let fail = |reason: String| crate::Error::File {
             path: path.into(),
             reason,
@@ -134,51 +134,7 @@ impl SynthMap {
                 self.height
             )));
         }
-        let plane = |k: usize| -> FlatSamples {
-            if half {
-                let top = f16::MAX.to_f32();
-                FlatSamples::F16(
-                    self.rgb
-                        .iter()
-                        .map(|p| f16::from_f32(p[k].clamp(-top, top)))
-                        .collect(),
-                )
-            } else {
-                FlatSamples::F32(self.rgb.iter().map(|p| p[k]).collect())
-            }
-        };
-        let channels = AnyChannels::sort(SmallVec::from_vec(vec![
-            AnyChannel::new("B", plane(2)),
-            AnyChannel::new("G", plane(1)),
-            AnyChannel::new("R", plane(0)),
-        ]));
-        let encoding = if half {
-            Encoding {
-                compression: Compression::DWAB(None),
-                blocks: Blocks::Tiles(Vec2(64, 64)),
-                line_order: LineOrder::Increasing,
-            }
-        } else {
-            Encoding {
-                compression: Compression::ZIP16,
-                blocks: Blocks::ScanLines,
-                line_order: LineOrder::Increasing,
-            }
-        };
-        let layer = Layer::new(
-            (self.width, self.height),
-            LayerAttributes::named("synth"),
-            encoding,
-            channels,
-        );
-        // the encoder is third-party code: a panic in it becomes an error
-        // naming the file
-        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            Image::from_layer(layer).write().to_file(path)
-        })) {
-            Ok(Ok(())) => Ok(()),
-            Ok(Err(e)) => Err(fail(format!("cannot write the EXR: {e}"))),
-            Err(_) => Err(fail("cannot write the EXR: the encoder failed".into())),
-        }
+        crate::io::image::openexr::write_rgb(path, self.width, self.height, &self.rgb, half)
+            .map_err(fail)
     }
 }

@@ -41,16 +41,30 @@ pub(crate) struct LightsArgs {
     /// Lloyd steps after the first cut (each one more pass over the map).
     #[arg(long, default_value_t = tessera::lights::DEFAULT_LLOYD_STEPS)]
     lloyd: usize,
+    /// Draw the directions with this sphere table (a `.lut` file `tessera
+    /// lut build --system sphere` wrote) instead of the one built in: a
+    /// rebuilt table without recompiling.
+    #[arg(long, value_name = "FILE")]
+    table: Option<PathBuf>,
 }
 
 /// `lights`: read the map's colour and importance in one decode, warn and
 /// refuse as `sphere --map` does, write the lights.
 pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
     use tessera::lights::LightOptions;
+    use tessera::lut::{Table, TableSystem};
     let options = tessera::io::image::ReadOptions {
         channel: args.channel.clone(),
         strict: args.strict,
         ..Default::default()
+    };
+    // the table first: a bad one is refused before the map is decoded
+    let table = match &args.table {
+        Some(path) => match Table::open(path, TableSystem::Sphere)? {
+            Table::Sphere(lut) => Some(lut),
+            _ => unreachable!("Table::open returns a table of the system asked for"),
+        },
+        None => None,
     };
     let (map, rgb, warnings) =
         tessera::request::open_light_map(&args.map, &options, args.up.into())?;
@@ -62,6 +76,7 @@ pub(crate) fn lights(args: LightsArgs) -> Result<(), Error> {
         exponent: args.exponent,
         lloyd_steps: args.lloyd,
         seed: args.seed,
+        table: table.as_deref(),
         ..Default::default()
     };
     let lights = tessera::lights::lights(&map, args.count, &options)?;

@@ -20,10 +20,12 @@ pub(crate) struct MetricsArgs {
     /// below (whatever N: --pairs-up-to does not apply to them).
     #[arg(long, value_name = "KEY,...")]
     only: Option<String>,
-    /// Also print the spectrum: `angular_power`, P(l) for l = 0..64
-    /// (sphere), or `radial_power` and `anisotropy_db` per ring (plane; out
-    /// to twice the blue-noise peak, of a corner window holding 20000
-    /// points above that many).
+    /// Also print the spectrum: `angular_power`, P(l) for l = 0..3 sqrt(N)
+    /// (sphere; at least 64, at most 1024, and lower where
+    /// N (l + 1)(l + 2) / 2 would pass 3x10^10 steps, above about
+    /// N = 82000), or `radial_power`
+    /// and `anisotropy_db` per ring (plane; out to twice the blue-noise
+    /// peak, of a corner window holding 20000 points above that many).
     #[arg(long)]
     spectrum: bool,
     /// Write a PNG: the angular power spectrum plot (sphere), or the
@@ -37,9 +39,6 @@ pub(crate) struct MetricsArgs {
     #[arg(long, value_name = "N", default_value_t = tessera::metrics::PAIRS_UP_TO)]
     pairs_up_to: usize,
 }
-
-/// Angular power spectrum degrees printed and plotted by `metrics sphere`.
-pub(crate) const SPECTRUM_L_MAX: usize = 64;
 
 /// The long help's list of every key `metrics` prints, from the library's
 /// own descriptions.
@@ -59,9 +58,13 @@ pub(crate) fn measures_help() -> String {
         "With --spectrum:\n  \
          angular_power (sphere)\n      \
          P(l) = (1/N) sum over all ordered pairs (i = j included) of \
-         P_l(x_i . x_j), Legendre polynomials, l = 0..64: P(0) = N, 1 in \
+         P_l(x_i . x_j), Legendre polynomials, for l = 0 to 3 sqrt(N) (at \
+         least 64; at most 1024, and capped where N (l + 1)(l + 2) / 2 passes \
+         3x10^10 recurrence steps, above about N = 82000, with a note on \
+         stderr): P(0) = N, 1 in \
          expectation for independent uniform points, low below the blue-noise \
-         peak.\n  \
+         peak (near l = 2 sqrt(N)). Computed per point by the addition \
+         theorem, O(N l^2).\n  \
          radial_power (plane)\n      \
          The periodogram |sum_j exp(-2 pi i k.x_j)|^2 / N averaged over each \
          ring of integer radius |k| = 0, 1, ...: white noise 1.\n  \
@@ -84,7 +87,17 @@ pub(crate) fn metrics(args: MetricsArgs) -> Result<(), Error> {
             let report = Printed::new(&sphere::measure(&points, &options(&args, &progress)?));
             let mut spectrum = Vec::new();
             if spectral {
-                let power = sphere::angular_power_with(&points, SPECTRUM_L_MAX, &progress);
+                let l_max = sphere::spectrum_degree(points.len());
+                let wanted = (3.0 * (points.len() as f64).sqrt()).ceil() as usize;
+                if l_max < wanted {
+                    eprintln!(
+                        "tessera: {}: the spectrum stops at l = {l_max}, below 3 sqrt(N) = {wanted} (its cost is capped at {:e} steps and l <= {})",
+                        args.file.display(),
+                        sphere::SPECTRUM_STEPS as f64,
+                        sphere::SPECTRUM_L_CAP
+                    );
+                }
+                let power = sphere::angular_power_with(&points, l_max, &progress);
                 save_figure(&args, || plot::angular_power_figure(&power))?;
                 spectrum.push(("angular_power", power));
             }
