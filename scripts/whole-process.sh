@@ -6,12 +6,23 @@
 # program writes the same kind of bytes (UTK binary, f64) to /dev/null.
 # Prints a markdown table: median wall time and peak RSS of each side over
 # RUNS runs, and the ratio of the medians (tessera / baseline).
-#   bash scripts/whole-process.sh [RUNS] [--large]
-# --large adds 10^8 sphere points and 4096x2048 and 8192x4096 maps.
+#   bash scripts/whole-process.sh [RUNS] [--large] [--only TEXT]
+# --large adds 10^8 sphere points and 4096x2048 and 8192x4096 maps;
+# --only TEXT keeps the requests whose label contains TEXT.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-5}
-large=${2:-}
+shift || true
+large=
+only=
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --large) large=1 ;;
+    --only) only=$2; shift ;;
+    *) echo "whole-process.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+  shift
+done
 cargo build -q --release --bin tessera --example plain_writers --example synth_maps
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -47,6 +58,7 @@ echo "| request | tessera threads | tessera (s) | baseline (s) | ratio | tessera
 echo "|---|---:|---:|---:|---:|---:|---:|"
 for case in "${cases[@]}"; do
   IFS='|' read -r label threads targs bargs <<<"$case"
+  [[ "$label" == *"$only"* ]] || continue
   : >"$work/t"
   : >"$work/b"
   for _ in $(seq "$runs"); do
