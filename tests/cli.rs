@@ -813,7 +813,7 @@ fn strict_passes_compression_noise_and_refuses_damage() {
     let dir = std::env::temp_dir().join(format!("tessera-strict-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let noisy = tessera::synth::Sky::all()
-        .into_iter()
+        .iter()
         .find_map(|sky| {
             let path = dir.join(format!("{}.exr", sky.name()));
             sky.generate(256, 128, 1).write_exr(&path, true).unwrap();
