@@ -141,14 +141,18 @@ impl MapArray {
     fn copy(array: &PyReadonlyArrayDyn<'_, f64>) -> PyResult<MapArray> {
         let shape = array.shape().to_vec();
         let view = array.as_array();
+        // (the Python side passes C-contiguous arrays: read in place)
+        let flat = match view.as_slice() {
+            Some(flat) => std::borrow::Cow::Borrowed(flat),
+            None => std::borrow::Cow::Owned(view.iter().copied().collect()),
+        };
         match shape[..] {
             [height, width] => Ok(MapArray::Grey {
                 width,
                 height,
-                values: view.iter().copied().collect(),
+                values: flat.into_owned(),
             }),
             [height, width, 3] => {
-                let flat: Vec<f64> = view.iter().copied().collect();
                 // colour is held in f32, as a file's channels are
                 let rgb = flat
                     .chunks_exact(3)
@@ -236,7 +240,9 @@ fn map_source(
     match (path, array) {
         (Some(path), None) => Ok(MapSource::Path(path)),
         (None, Some(array)) => Ok(MapSource::Array(MapArray::copy(&array)?)),
-        _ => Err(PyValueError::new_err("a map is a path or an array, one of them")),
+        _ => Err(PyValueError::new_err(
+            "a map is a path or an array, one of them",
+        )),
     }
 }
 
@@ -363,8 +369,8 @@ fn sphere<'py>(
     relax: usize,
     table: Option<PathBuf>,
 ) -> PyResult<Points<'py>> {
-    let density = sphere_density(&density, map.as_deref(), healpix.as_deref())
-        .map_err(Failure::from)?;
+    let density =
+        sphere_density(&density, map.as_deref(), healpix.as_deref()).map_err(Failure::from)?;
     let (points, pdfs) = run(py, threads, move || {
         let request = SphereRequest {
             count: n,
@@ -399,8 +405,8 @@ fn pdf<'py>(
     healpix: Option<PyRef<'py, Healpix>>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let density = sphere_density(&density, map.as_deref(), healpix.as_deref())
-        .map_err(Failure::from)?;
+    let density =
+        sphere_density(&density, map.as_deref(), healpix.as_deref()).map_err(Failure::from)?;
     let directions: Vec<DVec3> = rows::<3>(&directions)?
         .into_iter()
         .map(DVec3::from_array)
