@@ -138,3 +138,21 @@ impl SynthMap {
             .map_err(fail)
     }
 }
+
+/// Run with `cargo test --no-default-features --lib synth`: the default
+/// build writes EXR.
+#[cfg(all(test, not(feature = "exr")))]
+mod tests {
+    /// Without the `exr` feature, writing a map is refused with an error
+    /// naming the file and the feature.
+    #[test]
+    fn writing_exr_without_the_codec_names_file_and_feature() {
+        let path = std::env::temp_dir().join("tessera-no-exr.exr");
+        let map = super::Sky::Overcast.generate(8, 4, 1);
+        let e = map.write_exr(&path, false).unwrap_err().to_string();
+        assert!(
+            e.contains("tessera-no-exr.exr") && e.contains("`exr` feature"),
+            "{e}"
+        );
+    }
+}

@@ -1,6 +1,6 @@
 //! OpenEXR through the `exr` crate (the `exr` feature): the reader behind
-//! [`super::read_raster`] and the writer behind
-//! [`crate::synth::SynthMap::write_exr`].
+//! [`super::read_raster`] and the writer behind the synthetic maps'
+//! `write_exr`.
 
 use super::{check_size, Channel, Decoded};
 use std::path::Path;
