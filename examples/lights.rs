@@ -664,6 +664,10 @@ fn bench_times(doc: &mut String) {
     }
 }
 
+/// A sweep entry's exponent, cap, Lloyd weight and steps, and its summed
+/// log ratios per N.
+type SweepRow = (String, f64, &'static str, usize, Vec<[f64; 3]>);
+
 /// The measurements behind the default exponent, pixel cap and Lloyd steps.
 fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     let default_configs = [
@@ -706,7 +710,7 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     );
     let _ = writeln!(doc, "| exponent | pixel cap | Lloyd weight | Lloyd steps | diffuse | glossy 10 | glossy 100 | misses | mean time (ms) |");
     let _ = writeln!(doc, "|---:|---:|---|---:|---:|---:|---:|---:|---:|");
-    let mut per_n: Vec<(String, f64, &str, usize, Vec<[f64; 3]>)> = Vec::new();
+    let mut per_n: Vec<SweepRow> = Vec::new();
     for &(e, cap, weight) in &configs {
         for &k in &steps {
             let name = e.map_or("per N".to_string(), |e| e.to_string());
