@@ -273,7 +273,7 @@ pub struct LightOptions<'a> {
     /// cells' mean directions (weighted by the square of the drawn density)
     /// and re-centres, for one more pass over a grid of blocks of up to
     /// 8 x 8 pixels, at least 32 blocks per light (see [`LloydWeight`];
-    /// about 30-40 ms on one thread for a 1024 x 512 map at `n = 4096`,
+    /// about 40 ms on one thread for a 1024 x 512 map at `n = 4096`,
     /// docs/LIGHTS.md); at most 100.
     pub lloyd_steps: usize,
     /// Split boundary pixels until a piece holds at most this fraction of
@@ -605,7 +605,8 @@ pub fn lights_with_stats(
 /// keeps the drawn spread and only evens the cells' shapes. The blocks
 /// (`f` the largest power of two up to [`PLACEMENT_MAX_BLOCK`] dividing the
 /// map that leaves [`PLACEMENT_BLOCKS_PER_LIGHT`] blocks per light) make a
-/// step several times cheaper; the last cut is on the map's own pixels.
+/// step somewhat cheaper (a pass's cost is mostly its `4 n` groups of
+/// pixels, not its pixels); the last cut is on the map's own pixels.
 struct Placement {
     width: usize,
     height: usize,
