@@ -91,6 +91,7 @@ struct Reference {
 /// A map in one frame, with its references.
 struct Case {
     sky: Sky,
+    seed: u64,
     frame: &'static str,
     rgb: RgbMap,
     map: EnvMap,
@@ -429,6 +430,9 @@ fn main() {
                 false,
                 &mut doc,
             );
+            if args.sweep {
+                spread(&held, &probes, &args.options, &mut doc);
+            }
         }
     }
     let _ = writeln!(
@@ -455,6 +459,7 @@ fn build_cases(seed: u64, frames: &[(&'static str, DMat3)], probes: &Probes) -> 
             let reference = reference(&map, probes);
             cases.push(Case {
                 sky,
+                seed,
                 frame,
                 rgb,
                 map,
@@ -803,8 +808,8 @@ fn spread(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
     const SEEDS: u64 = 8;
     let _ = writeln!(
         doc,
-        "## How much one set's error is luck
-"
+        "\n## How much one set's error is luck (seed-{} maps)\n",
+        cases.first().map_or(0, |c| c.seed)
     );
     let _ = writeln!(
         doc,
