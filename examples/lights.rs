@@ -4,7 +4,8 @@
 //!
 //!     cargo run --release --example lights -- [--write] [--sweep] [--held-out]
 //!         [--quick] [--no-tables] [--exponent E] [--cap C] [--lloyd K]
-//!         [--tolerance T] [--configs E:C,...] [--steps K,...] [--counts N,...]
+//!         [--tolerance T] [--configs E:C[:map],...] [--steps K,...] [--counts N,...]
+//!         [--map-seed S] [--no-quadrature]
 //!
 //! For each map (clear sky, overcast, city at night, interior; 1024 x 512,
 //! seed 1) and each frame, the reference integrals are computed by
@@ -17,9 +18,12 @@
 //! the error is the relative RMSE over the normals (axes).
 //!
 //! `--sweep` adds the measurements behind the default density exponent,
-//! pixel cap and Lloyd steps (`--configs`, `--steps`, `--counts` narrow it)
-//! and the accuracy of the cells; `--held-out` repeats the summary on the
-//! maps of seed 2; `--write` writes docs/LIGHTS.md and docs/img/lights.png
+//! pixel cap and Lloyd steps (`--configs`, `--steps`, `--counts` narrow it;
+//! `:map` weights the Lloyd steps by the map itself), the spread of the
+//! error over seeded frames and the accuracy of the cells
+//! (`--no-quadrature` skips it); `--map-seed` generates the main maps from
+//! another seed (1 by default); `--held-out` repeats the summary on the
+//! maps of seeds 2 and 3; `--write` writes docs/LIGHTS.md and docs/img/lights.png
 //! (`--write --sweep --held-out` is the full document); `--quick` runs only
 //! the unrotated maps; `--exponent`, `--cap`, `--lloyd`, `--tolerance`
 //! override tessera's defaults in the tables.
@@ -32,13 +36,15 @@ use std::time::Instant;
 use tessera::baselines::median_cut::{median_cut, MedianCut};
 use tessera::baselines::{random_rotation, uniform_random_sphere};
 use tessera::density::envmap::EnvMap;
-use tessera::lights::{lights, lights_with_stats, Light, LightOptions, RgbMap};
+use tessera::lights::{lights, lights_with_stats, Light, LightOptions, LloydWeight, RgbMap};
 use tessera::metrics::irradiance::relative_rmse;
 use tessera::synth::{Sky, SynthMap};
 
 const W: usize = 1024;
 const H: usize = 512;
 const COUNTS: [usize; 9] = [64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384];
+/// The maps' seeds of the held-out checks (`--held-out`).
+const HELD_OUT: [u64; 2] = [2, 3];
 const SKIES: [Sky; 4] = [Sky::ClearSky, Sky::Overcast, Sky::CityNight, Sky::Interior];
 
 /// The method paragraph of docs/LIGHTS.md.
@@ -85,6 +91,7 @@ struct Reference {
 /// A map in one frame, with its references.
 struct Case {
     sky: Sky,
+    seed: u64,
     frame: &'static str,
     rgb: RgbMap,
     map: EnvMap,
@@ -255,7 +262,9 @@ struct Args {
     quick: bool,
     no_tables: bool,
     held_out: bool,
-    configs: Option<Vec<(Option<f64>, f64)>>,
+    no_quadrature: bool,
+    map_seed: u64,
+    configs: Option<Vec<(Option<f64>, f64, LloydWeight)>>,
     steps: Option<Vec<usize>>,
     counts: Option<Vec<usize>>,
     options: LightOptions<'static>,
@@ -268,6 +277,8 @@ fn args() -> Args {
         quick: false,
         no_tables: false,
         held_out: false,
+        no_quadrature: false,
+        map_seed: 1,
         configs: None,
         steps: None,
         counts: None,
@@ -286,15 +297,25 @@ fn args() -> Args {
             "--quick" => a.quick = true,
             "--no-tables" => a.no_tables = true,
             "--held-out" => a.held_out = true,
+            "--no-quadrature" => a.no_quadrature = true,
+            "--map-seed" => a.map_seed = value("--map-seed") as u64,
             "--configs" => {
-                // EXPONENT:CAP,EXPONENT:CAP,... (EXPONENT `auto`: the rule of N)
+                // EXPONENT:CAP[:map],... (EXPONENT `auto`: the rule of N;
+                // `:map`: Lloyd steps weighted by the map itself)
                 let list = it.next().expect("--configs needs a list");
                 a.configs = Some(
                     list.split(',')
                         .map(|c| {
-                            let (e, cap) = c.split_once(':').expect("EXPONENT:CAP");
+                            let mut parts = c.split(':');
+                            let e = parts.next().expect("EXPONENT:CAP");
                             let e = (e != "auto").then(|| e.parse().expect("exponent"));
-                            (e, cap.parse().expect("cap"))
+                            let cap = parts.next().expect("EXPONENT:CAP");
+                            let weight = match parts.next() {
+                                Some("map") => LloydWeight::Map,
+                                None => LloydWeight::DrawnSquared,
+                                Some(other) => panic!("unknown Lloyd weight {other}"),
+                            };
+                            (e, cap.parse().expect("cap"), weight)
                         })
                         .collect(),
                 );
@@ -336,7 +357,7 @@ fn main() {
     if args.quick {
         frames.truncate(1);
     }
-    let cases = build_cases(1, &frames, &probes);
+    let cases = build_cases(args.map_seed, &frames, &probes);
     eprintln!(
         "maps and references: {:.1} s",
         started.elapsed().as_secs_f64()
@@ -384,26 +405,35 @@ fn main() {
     }
     if args.sweep {
         sweep(&cases, &probes, &args, &mut doc);
-        quadrature(&cases, &mut doc);
+        spread(&cases, &probes, &args.options, &mut doc);
+        if !args.no_quadrature {
+            quadrature(&cases, &mut doc);
+        }
     }
     if !args.no_tables {
         tables(&cases, &probes, &args.options, "Summary", true, &mut doc);
     }
     bench_times(&mut doc);
     if args.held_out {
-        let held = build_cases(2, &frames, &probes);
-        let _ = writeln!(
-            doc,
-            "\n# Held out: the same maps generated from seed 2\n\nThe defaults were chosen on the seed-1 maps above; the same comparison on the maps of seed 2 (another sun position, other lights, lamps and texture), in the same frames:\n"
-        );
-        tables(
-            &held,
-            &probes,
-            &args.options,
-            "Held-out summary",
-            false,
-            &mut doc,
-        );
+        for seed in HELD_OUT {
+            let held = build_cases(seed, &frames, &probes);
+            let _ = writeln!(
+                doc,
+                "\n# Held out: the same maps generated from seed {seed}\n\nThe defaults were chosen on the seed-{} maps above; the same comparison on the maps of seed {seed} (another sun position, other lights, lamps and texture), in the same frames:\n",
+                args.map_seed
+            );
+            tables(
+                &held,
+                &probes,
+                &args.options,
+                &format!("Held-out summary, seed {seed}"),
+                false,
+                &mut doc,
+            );
+            if args.sweep {
+                spread(&held, &probes, &args.options, &mut doc);
+            }
+        }
     }
     let _ = writeln!(
         doc,
@@ -429,6 +459,7 @@ fn build_cases(seed: u64, frames: &[(&'static str, DMat3)], probes: &Probes) -> 
             let reference = reference(&map, probes);
             cases.push(Case {
                 sky,
+                seed,
                 frame,
                 rgb,
                 map,
@@ -574,22 +605,33 @@ fn tables(
 /// The single-thread times of `cargo bench --bench lights`, read from
 /// criterion's saved estimates when that bench has been run.
 fn bench_times(doc: &mut String) {
-    let dir = std::path::Path::new("target/criterion/lights_1024x512_n4096_1_thread");
-    let names = [
-        ("load_only", "reading the EXR (colour and importance) only"),
-        ("tessera_lloyd_0", "tessera, 0 Lloyd steps"),
-        ("tessera_lloyd_1", "tessera, 1 Lloyd step"),
-        ("tessera_lloyd_2", "tessera, 2 Lloyd steps"),
-        (
-            "tessera_lloyd_3_default",
-            "tessera, 3 Lloyd steps (the default)",
-        ),
-        ("median_cut_classic", "classic median cut"),
-        ("median_cut_greedy", "greedy median cut"),
-    ];
+    let target = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".to_string());
+    let dir = std::path::Path::new(&target).join("criterion/lights_1024x512_n4096_1_thread");
+    let default_steps = LightOptions::default().lloyd_steps;
+    let mut names = vec![(
+        "load_only".to_string(),
+        "reading the EXR (colour and importance) only".to_string(),
+    )];
+    for k in [0, 3, 6, 10] {
+        let (name, what) = if k == default_steps {
+            (
+                format!("tessera_lloyd_{k}_default"),
+                format!("tessera, {k} Lloyd steps (the default)"),
+            )
+        } else {
+            (
+                format!("tessera_lloyd_{k}"),
+                format!("tessera, {k} Lloyd steps"),
+            )
+        };
+        names.push((name, what));
+    }
+    for v in ["classic", "greedy"] {
+        names.push((format!("median_cut_{v}"), format!("{v} median cut")));
+    }
     let mut rows = Vec::new();
     for (name, what) in names {
-        let path = dir.join(name).join("new/estimates.json");
+        let path = dir.join(&name).join("new/estimates.json");
         let Ok(text) = std::fs::read_to_string(&path) else {
             continue;
         };
@@ -627,24 +669,20 @@ fn bench_times(doc: &mut String) {
     }
 }
 
+/// A sweep entry's exponent, cap, Lloyd weight and steps, and its summed
+/// log ratios per N.
+type SweepRow = (String, f64, &'static str, usize, Vec<[f64; 3]>);
+
 /// The measurements behind the default exponent, pixel cap and Lloyd steps.
 fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
-    let inf = f64::INFINITY;
     let default_configs = [
-        (Some(0.5), inf),
-        (Some(0.75), inf),
-        (Some(0.875), inf),
-        (Some(1.0), inf),
-        (Some(0.625), 1.0),
-        (Some(0.75), 1.0),
-        (Some(0.875), 1.0),
-        (Some(0.95), 1.0),
-        (Some(1.0), 1.0),
-        (Some(0.875), 4.0),
-        (None, 1.0),
+        (Some(0.875), 1.0, LloydWeight::DrawnSquared),
+        (Some(1.0), 1.0, LloydWeight::DrawnSquared),
+        (None, 1.0, LloydWeight::Map),
+        (None, 1.0, LloydWeight::DrawnSquared),
     ];
     let configs = args.configs.clone().unwrap_or(default_configs.to_vec());
-    let steps = args.steps.clone().unwrap_or(vec![0usize, 1, 2, 3]);
+    let steps = args.steps.clone().unwrap_or(vec![0usize, 3, 6, 10]);
     let counts = args
         .counts
         .clone()
@@ -671,20 +709,25 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     );
     let _ = writeln!(
         doc,
-        "Every map and frame at N = {} ({} cells per entry): the geometric mean of tessera's error over the better median cut's, in brackets the worst cell; misses: cells where a floor fails (diffuse above 1 at N = 256, 1024 or 4096; glossy at or above 1 at any N). Time: the mean wall time of one `lights` call on this machine's threads.\n",
+        "Every map and frame at N = {} ({} cells per entry): the geometric mean of tessera's error over the better median cut's, in brackets the worst cell; misses: cells where a floor fails (diffuse above 1 at N = 256, 1024 or 4096; glossy at or above 1 at any N). Time: the mean wall time of one `lights` call on this machine's threads. Lloyd weight: what the Lloyd steps centre the cells by, `drawn^2` the square of the drawn density `min(L^e, cap)` on blocks of up to 8 x 8 pixels (a Lloyd iteration spreads its points as the square root of its weight, so these steps keep the drawn spread), `map` the map itself on its pixels (the steps pull the spread towards `L^(1/2)`).\n",
         counts.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", "),
         cases.len() * counts.len()
     );
-    let _ = writeln!(doc, "| exponent | pixel cap | Lloyd steps | diffuse | glossy 10 | glossy 100 | misses | mean time (ms) |");
-    let _ = writeln!(doc, "|---:|---:|---:|---:|---:|---:|---:|---:|");
-    let mut per_n: Vec<(String, f64, usize, Vec<[f64; 3]>)> = Vec::new();
-    for &(e, cap) in &configs {
+    let _ = writeln!(doc, "| exponent | pixel cap | Lloyd weight | Lloyd steps | diffuse | glossy 10 | glossy 100 | misses | mean time (ms) |");
+    let _ = writeln!(doc, "|---:|---:|---|---:|---:|---:|---:|---:|---:|");
+    let mut per_n: Vec<SweepRow> = Vec::new();
+    for &(e, cap, weight) in &configs {
         for &k in &steps {
             let name = e.map_or("per N".to_string(), |e| e.to_string());
+            let wname = match weight {
+                LloydWeight::DrawnSquared => "drawn^2",
+                LloydWeight::Map => "map",
+            };
             let options = LightOptions {
                 exponent: e,
                 pixel_cap: cap,
                 lloyd_steps: k,
+                lloyd_weight: weight,
                 ..Default::default()
             };
             let mut logs = [0.0; 3];
@@ -721,7 +764,7 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
             let cells = (cases.len() * counts.len()) as f64;
             let _ = writeln!(
                 doc,
-                "| {name} | {cap} | {k} | {:.3} ({:.2}) | {:.3} ({:.2}) | {:.3} ({:.2}) | {misses} | {:.0} |",
+                "| {name} | {cap} | {wname} | {k} | {:.3} ({:.2}) | {:.3} ({:.2}) | {:.3} ({:.2}) | {misses} | {:.0} |",
                 (logs[0] / cells).exp(),
                 worst[0],
                 (logs[1] / cells).exp(),
@@ -731,22 +774,22 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
                 time / cells * 1e3
             );
             eprintln!("sweep exponent {name} cap {cap} Lloyd {k} done");
-            per_n.push((name, cap, k, by_n));
+            per_n.push((name, cap, wname, k, by_n));
         }
     }
     let _ = writeln!(
         doc,
         "\nThe same geometric means per N (diffuse / glossy 10 / glossy 100):\n"
     );
-    let mut header = String::from("| exponent | pixel cap | Lloyd steps |");
-    let mut rule = String::from("|---:|---:|---:|");
+    let mut header = String::from("| exponent | pixel cap | Lloyd weight | Lloyd steps |");
+    let mut rule = String::from("|---:|---:|---|---:|");
     for n in &counts {
         let _ = write!(header, " N = {n} |");
         rule.push_str("---|");
     }
     let _ = writeln!(doc, "{header}\n{rule}");
-    for (e, cap, k, by_n) in per_n {
-        let mut row = format!("| {e} | {cap} | {k} |");
+    for (e, cap, wname, k, by_n) in per_n {
+        let mut row = format!("| {e} | {cap} | {wname} | {k} |");
         for v in by_n {
             let g: Vec<String> = v
                 .iter()
@@ -755,6 +798,60 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
             let _ = write!(row, " {} |", g.join(" / "));
         }
         let _ = writeln!(doc, "{row}");
+    }
+    let _ = writeln!(doc);
+}
+
+/// How much tessera's error moves with the frame it draws in (`seed`),
+/// beside the better median cut's, on the smooth overcast map.
+fn spread(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut String) {
+    const SEEDS: u64 = 8;
+    let _ = writeln!(
+        doc,
+        "\n## How much one set's error is luck (seed-{} maps)\n",
+        cases.first().map_or(0, |c| c.seed)
+    );
+    let _ = writeln!(
+        doc,
+        "The overcast map, diffuse error, the default options: the unseeded set and {SEEDS} sets drawn in random frames (`seed` 1-{SEEDS}), beside the better median cut's error. A deterministic set's error is one draw from this spread; median cut's moves with the frame too.\n"
+    );
+    let _ = writeln!(doc, "| frame | N | median cut (better) | tessera unseeded | seeded min | seeded median | seeded max | unseeded / MC | seeded median / MC |");
+    let _ = writeln!(doc, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for case in cases.iter().filter(|c| c.sky == Sky::Overcast) {
+        for n in [256, 4096] {
+            let best = MedianCut::all()
+                .map(|v| {
+                    let l = median_cut(&case.map, Some(&case.rgb), n, v).expect("cut");
+                    errors(&l, probes, &case.reference)[0]
+                })
+                .into_iter()
+                .fold(f64::INFINITY, f64::min);
+            let run = |seed: Option<u64>| {
+                let o = LightOptions {
+                    rgb: Some(&case.rgb),
+                    seed,
+                    ..*options
+                };
+                errors(
+                    &lights(&case.map, n, &o).expect("lights"),
+                    probes,
+                    &case.reference,
+                )[0]
+            };
+            let unseeded = run(None);
+            let mut seeded: Vec<f64> = (1..=SEEDS).map(|k| run(Some(k))).collect();
+            seeded.sort_by(f64::total_cmp);
+            let median = (seeded[SEEDS as usize / 2 - 1] + seeded[SEEDS as usize / 2]) / 2.0;
+            let _ = writeln!(
+                doc,
+                "| {} | {n} | {best:.2e} | {unseeded:.2e} | {:.2e} | {median:.2e} | {:.2e} | {:.2} | {:.2} |",
+                case.frame,
+                seeded[0],
+                seeded[SEEDS as usize - 1],
+                unseeded / best,
+                median / best
+            );
+        }
     }
     let _ = writeln!(doc);
 }

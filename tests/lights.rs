@@ -11,7 +11,8 @@ use tessera::baselines::median_cut::{median_cut, MedianCut};
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::io::image::{read_raster, Raster, ReadOptions};
 use tessera::lights::{
-    lights, lights_with_stats, read_rgb, Light, LightOptions, RgbMap, DEFAULT_TOLERANCE,
+    lights, lights_with_stats, read_rgb, Light, LightOptions, LloydWeight, RgbMap,
+    DEFAULT_TOLERANCE,
 };
 use tessera::synth::Sky;
 
@@ -292,8 +293,10 @@ fn lloyd_steps_lower_the_quantisation_energy() {
     let rgb = RgbMap::from(Sky::Overcast.generate(256, 128, 1));
     let map = rgb.env_map(Up::Z).unwrap();
     let energy = |steps: usize| {
+        // the map-weighted iteration is Lloyd's for this energy
         let options = LightOptions {
             lloyd_steps: steps,
+            lloyd_weight: LloydWeight::Map,
             ..Default::default()
         };
         let (l, stats) = lights_with_stats(&map, 300, &options).unwrap();
@@ -317,6 +320,36 @@ fn lloyd_steps_lower_the_quantisation_energy() {
     };
     let e: Vec<f64> = (0..3).map(energy).collect();
     assert!(e[1] < e[0] && e[2] < e[1], "{e:?}");
+}
+
+#[test]
+fn drawn_squared_lloyd_steps_keep_the_drawn_spread() {
+    // top half 4, bottom half 1, drawn in proportion (exponent 1, no cap):
+    // 4/5 of the lights on top; Lloyd steps weighted by the map drift
+    // towards sqrt(4) / (sqrt(4) + 1) = 2/3, weighted by the drawn density
+    // squared they stay
+    let (w, h) = (128, 64);
+    let values: Vec<f64> = (0..w * h)
+        .map(|p| if p / w < h / 2 { 4.0 } else { 1.0 })
+        .collect();
+    let map = EnvMap::new(raster(w, h, values), Up::Z).unwrap();
+    let top = |weight: LloydWeight, steps: usize| {
+        let options = LightOptions {
+            exponent: Some(1.0),
+            pixel_cap: f64::INFINITY,
+            lloyd_steps: steps,
+            lloyd_weight: weight,
+            ..Default::default()
+        };
+        let l = lights(&map, 400, &options).unwrap();
+        l.iter().filter(|l| l.direction.z > 0.0).count() as f64 / 400.0
+    };
+    let drawn = top(LloydWeight::DrawnSquared, 0);
+    let kept = top(LloydWeight::DrawnSquared, 50);
+    let drifted = top(LloydWeight::Map, 50);
+    assert!((drawn - 0.8).abs() < 0.02, "{drawn}");
+    assert!((kept - 0.8).abs() < 0.02, "{kept}");
+    assert!(drifted < kept - 0.03, "{drifted}");
 }
 
 #[test]

@@ -528,7 +528,7 @@ def plane(
     return (points, pdfs) if pdf else points
 
 
-def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=None, lloyd=3, threads=None):
+def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=None, lloyd=6, threads=None):
     """An environment map as n directional lights with exact powers.
 
     What ``tessera lights --map MAP -n N`` writes, as a dict of arrays:

@@ -8,9 +8,13 @@
 //! directions' spherical Voronoi cells and gives each light its cell's
 //! power, the integral of each channel over the cell (map units x
 //! steradians), placed at the cell's luminance-weighted mean direction.
-//! Lloyd steps (3 by default) then re-cut the sphere around those mean
-//! directions and re-centre. The cells partition the sphere, so the powers
-//! sum to the map's integral in every channel, to rounding.
+//! Lloyd steps (6 by default) first even the cells' shapes: each re-cuts
+//! the sphere around the cells' mean directions and re-centres, weighted
+//! by the square of the drawn density so that the steps keep the drawn
+//! spread (a Lloyd iteration weighted by the map itself would drift to
+//! `L^(1/2)`), on blocks of up to 8 x 8 pixels. The cells partition the
+//! sphere, so the powers sum to the map's integral in every channel, to
+//! rounding.
 //!
 //! Cells are integrated over the per-pixel model (the map constant per
 //! pixel per steradian). A pixel that a distance bound proves to lie in
@@ -251,7 +255,7 @@ pub fn read_rgb(path: &Path, options: &ReadOptions) -> Result<(RgbMap, Raster), 
 /// ```
 /// let o = tessera::lights::LightOptions::default();
 /// assert!(o.rgb.is_none() && o.seed.is_none());
-/// assert!(o.rgb.is_none() && o.exponent.is_none() && o.lloyd_steps == 3);
+/// assert!(o.rgb.is_none() && o.exponent.is_none() && o.lloyd_steps == 6);
 /// assert!(o.table.is_none());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -268,10 +272,12 @@ pub struct LightOptions<'a> {
     /// few lights, not a share of `n` in proportion to its energy);
     /// infinite for no cap. Positive.
     pub pixel_cap: f64,
-    /// Density-weighted Lloyd steps after the first cut: each re-cuts the
-    /// sphere around the cells' mean directions and re-centres, for one
-    /// more pass over the pixels (about 50-100 ms on one thread for a
-    /// 1024 x 512 map at `n = 4096`); at most 100.
+    /// Lloyd steps before the last cut: each re-cuts the sphere around the
+    /// cells' mean directions (weighted by the square of the drawn density)
+    /// and re-centres, for one more pass over a grid of blocks of up to
+    /// 8 x 8 pixels, at least 32 blocks per light (see [`LloydWeight`];
+    /// about 40 ms on one thread for a 1024 x 512 map at `n = 4096`,
+    /// docs/LIGHTS.md); at most 100.
     pub lloyd_steps: usize,
     /// Split boundary pixels until a piece holds at most this fraction of
     /// an average light's power (`integral / n`) and solid angle
@@ -285,6 +291,32 @@ pub struct LightOptions<'a> {
     /// Draw the directions with this sphere table instead of the built-in
     /// one (a table read at run time, [`crate::lut::Table::open`]).
     pub table: Option<&'a SphereLut>,
+    /// What the Lloyd steps weight the cells' centres by.
+    pub lloyd_weight: LloydWeight,
+}
+
+/// What [`lights`]' Lloyd steps weight the cells' centres by (the lights
+/// themselves always end at their cells' luminance-weighted mean
+/// directions, with their cells' exact powers).
+///
+/// # Example
+/// ```
+/// use tessera::lights::{LightOptions, LloydWeight};
+/// assert_eq!(LightOptions::default().lloyd_weight, LloydWeight::DrawnSquared);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LloydWeight {
+    /// The square of the drawn density `min(L^e, cap)`, summed over blocks
+    /// of up to 8 x 8 pixels (at least 32 blocks per light): a Lloyd
+    /// iteration converges to points spread as the square root of its
+    /// weight, so these steps keep the drawn spread and only even the
+    /// cells' shapes (the default).
+    #[default]
+    DrawnSquared,
+    /// The map itself, on its own pixels: the steps pull the spread
+    /// towards `L^(1/2)` whatever the exponent (the weighting before
+    /// [`LloydWeight::DrawnSquared`], kept for comparison).
+    Map,
 }
 
 /// The density exponent for `n` lights when none is given, piecewise
@@ -323,7 +355,7 @@ pub const DEFAULT_PIXEL_CAP: f64 = 1.0;
 /// ```
 /// assert_eq!(tessera::lights::LightOptions::default().lloyd_steps, tessera::lights::DEFAULT_LLOYD_STEPS);
 /// ```
-pub const DEFAULT_LLOYD_STEPS: usize = 3;
+pub const DEFAULT_LLOYD_STEPS: usize = 6;
 /// Default tolerance of the boundary split.
 ///
 /// # Example
@@ -342,6 +374,7 @@ impl Default for LightOptions<'_> {
             tolerance: DEFAULT_TOLERANCE,
             seed: None,
             table: None,
+            lloyd_weight: LloydWeight::DrawnSquared,
         }
     }
 }
@@ -499,6 +532,16 @@ pub fn lights_with_stats(
         options.rgb.map(|m| &m.rgb[..]),
         row_area,
     );
+    // Lloyd steps place the generators on a coarser grid holding the
+    // square of the drawn density (see `Placement`); the last pass cuts
+    // the map itself
+    let place = match options.lloyd_weight {
+        LloydWeight::DrawnSquared => Some(Placement::new(density.values(), w, h, n)),
+        LloydWeight::Map => None,
+    };
+    let place_grid = place
+        .as_ref()
+        .map(|p| cells::Grid::new(p.width, p.height, &p.values, None, p.row_area.clone()));
     let tol_mass = options.tolerance * map.integral() / n as f64;
     let tol_area = options.tolerance * 4.0 * PI / n as f64;
     let lit = |m: DVec3| map.radiance(up.from_map(m)) > 0.0;
@@ -511,7 +554,13 @@ pub fn lights_with_stats(
         } else {
             1.0
         };
-        let cut = cells::cells(&grid, &gens, tol_mass * coarse, tol_area * coarse);
+        let cut = match (&place, &place_grid) {
+            (Some(p), Some(g)) if passes < options.lloyd_steps => {
+                let tol_place = options.tolerance * p.integral / n as f64;
+                cells::cells(g, &gens, tol_place * coarse, tol_area * coarse)
+            }
+            _ => cells::cells(&grid, &gens, tol_mass * coarse, tol_area * coarse),
+        };
         passes += 1;
         let centres: Vec<DVec3> = cut
             .acc
@@ -550,6 +599,68 @@ pub fn lights_with_stats(
             {
                 *g = p;
             }
+        }
+    }
+}
+
+/// What the Lloyd steps centre the cells by: the square of the drawn
+/// density, summed over blocks of `f x f` pixels.
+///
+/// A density-weighted Lloyd iteration converges to points spread as the
+/// square root of its density (the optimal quantiser's point density in
+/// two dimensions), so Lloyd steps weighted by the map itself would pull
+/// the drawn spread `min(L^e, cap)` towards `L^(1/2)` step by step: unequal
+/// cell powers, which the smooth integrands' second-order errors no longer
+/// cancel over. Weighted by the square of the drawn density, the iteration
+/// keeps the drawn spread and only evens the cells' shapes. The blocks
+/// (`f` the largest power of two up to [`PLACEMENT_MAX_BLOCK`] dividing the
+/// map that leaves [`PLACEMENT_BLOCKS_PER_LIGHT`] blocks per light) make a
+/// step somewhat cheaper (a pass's cost is mostly its `4 n` groups of
+/// pixels, not its pixels); the last cut is on the map's own pixels.
+struct Placement {
+    width: usize,
+    height: usize,
+    values: Vec<f64>,
+    row_area: Vec<f64>,
+    integral: f64,
+}
+
+/// The fewest placement blocks per light (see `Placement`).
+const PLACEMENT_BLOCKS_PER_LIGHT: usize = 32;
+/// The largest placement block side in pixels (see `Placement`).
+const PLACEMENT_MAX_BLOCK: usize = 8;
+
+impl Placement {
+    fn new(density: &[f64], w: usize, h: usize, n: usize) -> Self {
+        let mut f = 1;
+        while f < PLACEMENT_MAX_BLOCK
+            && w % (2 * f) == 0
+            && h % (2 * f) == 0
+            && (w / (2 * f)) * (h / (2 * f)) >= PLACEMENT_BLOCKS_PER_LIGHT * n
+        {
+            f *= 2;
+        }
+        let fine = row_solid_angles(w, h);
+        let (cw, ch) = (w / f, h / f);
+        let row_area = row_solid_angles(cw, ch);
+        let mut values = vec![0.0; cw * ch];
+        for j in 0..h {
+            for i in 0..w {
+                let d = density[j * w + i];
+                values[(j / f) * cw + i / f] += d * d * fine[j];
+            }
+        }
+        let mut integral = 0.0;
+        for (j, row) in values.chunks_mut(cw).enumerate() {
+            integral += row.iter().sum::<f64>();
+            row.iter_mut().for_each(|v| *v /= row_area[j]);
+        }
+        Placement {
+            width: cw,
+            height: ch,
+            values,
+            row_area,
+            integral,
         }
     }
 }
