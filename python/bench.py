@@ -25,6 +25,19 @@ import tempfile
 import time
 from pathlib import Path
 
+# glibc's malloc maps large blocks afresh (fresh pages, a page fault each
+# 4 KB) below a threshold it raises as it frees large blocks, so whether a
+# 24-32 MB output costs page faults on every call depends on each
+# process's history: the uniform sphere took 6-11 % longer from Python
+# than from Rust when timed first, 2-4 % less when timed after the other
+# requests, and both sides 75 ms with the threshold fixed (against
+# 90-100). Both processes run with the same fixed thresholds (the Rust one
+# inherits them), unless --allocator-as-is.
+ALLOCATOR = {"MALLOC_MMAP_THRESHOLD_": str(1 << 28), "MALLOC_TRIM_THRESHOLD_": str(1 << 29)}
+if "--allocator-as-is" not in sys.argv and any(os.environ.get(k) != v for k, v in ALLOCATOR.items()):
+    # glibc reads them at start-up: start again with them set
+    os.execve(sys.executable, [sys.executable, *sys.argv], {**os.environ, **ALLOCATOR})
+
 # numpy's OpenBLAS starts worker threads at import that spin on a core now
 # and then (`blas_thread_server` in a profile of this script, 2.5 % of its
 # CPU time), though nothing here calls BLAS: they would be counted as the
@@ -80,6 +93,9 @@ def main():
     parser.add_argument("--runs", type=int, default=20, help="timed calls per request and side")
     parser.add_argument("--threads", type=int, help="worker threads on both sides (default: all cores)")
     parser.add_argument("--no-build", action="store_true", help="use the example binary as built")
+    parser.add_argument(
+        "--allocator-as-is", action="store_true", help="keep glibc's dynamic malloc thresholds (see above)"
+    )
     args = parser.parse_args()
     if args.threads:
         # read by rayon's global pool, in the Rust example and in this process
