@@ -195,8 +195,11 @@ where
                     walker.visit(start, f64::INFINITY, &mut samples);
                     let in_range = buckets.count_into(&samples, &mut counts) && in_range;
                     sized.push((k, samples.len()));
-                    let counts_now: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
-                    (add(totals, &counts_now), sized, in_range, samples, counts)
+                    let mut totals = add(totals, &[]);
+                    for (total, &c) in totals.iter_mut().zip(&counts) {
+                        *total += c as usize;
+                    }
+                    (totals, sized, in_range, samples, counts)
                 },
             )
             .map(|(totals, sized, in_range, _, _)| (totals, sized, in_range))
