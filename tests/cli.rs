@@ -417,7 +417,7 @@ fn relax_evens_the_set_and_refuses_a_window() {
         ratio.trim().parse().expect("a number")
     };
     let (before, after) = (mesh("0"), mesh("3"));
-    assert!(before > 4.0 && after < 2.6, "{before} -> {after}");
+    assert!(after < 0.8 * before && after < 2.6, "{before} -> {after}");
     let out = tessera(&["sphere", "-n", "100", "--within", "0,0,10", "--relax", "2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--relax"));
@@ -631,9 +631,10 @@ fn report_normalises_by_the_local_density() {
         "{separation} {uniform_separation}"
     );
     assert!((mesh - uniform_mesh).abs() < 1e-4, "{mesh} {uniform_mesh}");
+    // unnormalised, the dense cap's spacing reads as crowding
     let (separation, mesh, uniform_separation, uniform_mesh) = reported("cap:0,90,30,16");
     assert!(
-        separation > 2.0 * uniform_separation,
+        separation > 1.5 * uniform_separation,
         "{separation} {uniform_separation}"
     );
     assert!(mesh < 0.5 * uniform_mesh, "{mesh} {uniform_mesh}");
