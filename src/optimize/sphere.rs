@@ -886,16 +886,7 @@ fn relax(
         for bin in 0..bins {
             let fraction = lut.bin_fractions[bin];
             let (offsets, r) = relax_bin(
-                tiling,
-                &tiles,
-                &rows,
-                row_count,
-                bins,
-                bin,
-                fraction,
-                &start,
-                iterations,
-                level,
+                tiling, &tiles, &rows, row_count, bins, bin, fraction, &start, iterations, level,
             );
             residual += r / bins as f64;
             for row in 0..row_count {
