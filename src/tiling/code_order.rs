@@ -8,7 +8,7 @@
 //! `h`, every tile of a run descending along the same digits. What that
 //! descent does to a tile depends only on its rule and orientation (its
 //! origin is scaled and shifted) and, for its class, on its rule and class:
-//! a [`Descent`] tabulates both once per run. A sample then costs a few
+//! a `Descent` tabulates both once per run. A sample then costs a few
 //! table reads and the system's placing of its point, whatever the depth,
 //! and the memory is the level-`k` list (at most [`LIST_TILES`] tiles),
 //! built once; consecutive code ranges (a stream's blocks) reuse it.
@@ -21,7 +21,7 @@ use std::ops::Range;
 
 /// The longest level list kept: a level with at most this many tiles
 /// serves every deeper one. Larger lists cost more memory and first
-/// touches; smaller ones more runs, each tabulating a [`Descent`].
+/// touches; smaller ones more runs, each tabulating a `Descent`.
 pub const LIST_TILES: usize = 1 << 18;
 
 /// Uniform samples of one level over consecutive code ranges (see
@@ -45,7 +45,7 @@ pub trait CodeOrder<P>: Send {
     fn fill(&mut self, codes: Range<usize>, out: &mut Vec<Sample<P>>);
 }
 
-/// How a polyomino system's tiles subdivide: what a [`Descent`] follows.
+/// How a polyomino system's tiles subdivide: what a `Descent` follows.
 pub(crate) trait Subdivision: Sync {
     /// Children a tile.
     fn arity(&self) -> usize;
@@ -98,7 +98,7 @@ impl Node {
     }
 }
 
-/// A descendant, as a [`Descent`] gives it.
+/// A descendant, as a `Descent` gives it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Placed {
     /// Its placement on its level's lattice.
