@@ -35,21 +35,6 @@ use crate::Error;
 use glam::{DVec2, DVec3};
 use std::path::Path;
 
-/// Uniform requests above this many samples always stream block by block
-/// ([`engine::stream`]) in bounded memory, in [`SphereRequest::with_points`]
-/// and [`PlaneRequest::with_points`]. Smaller ones stream only where no
-/// block rebuilds ancestor tiles ([`engine::Stream::rebuilds_ancestors`]),
-/// and are otherwise generated in memory first: at 10^7 sphere points a
-/// stream took about twice the in-memory path's CPU time on one thread
-/// (docs/PERFORMANCE.md, `scripts/whole-process.sh`). The points are the
-/// same either way.
-///
-/// # Example
-/// ```
-/// assert_eq!(tessera::request::STREAM_ABOVE, 1 << 24);
-/// ```
-pub const STREAM_ABOVE: usize = 1 << 24;
-
 /// What a sphere request samples: the command line's region strings
 /// (`--density`), a lat-long environment map (`--map`) or a HEALPix map
 /// (`--healpix-map`).
@@ -259,7 +244,7 @@ impl SphereRequest {
 
     /// [`SphereRequest::points`] handed to `sink` as an exact-size
     /// iterator: a uniform request (without window or relaxation) streams
-    /// block by block in bounded memory where [`STREAM_ABOVE`] says so, an
+    /// block by block in bounded memory ([`engine::stream`]), an
     /// unsorted one (without window or relaxation) a batch at a time
     /// ([`engine::unsorted`]); others are generated in memory first. This
     /// is how `tessera sphere` writes.
@@ -280,17 +265,15 @@ impl SphereRequest {
         if let SphereDensity::Regions(d) = density {
             let tiling = self.tiling()?;
             let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
-            match engine::stream(&tiling, self.count) {
-                Some(stream) if uniform && worth_streaming(&stream) => {
-                    // the frame of `Rotated::new(density, seed)`
-                    let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
-                    let mut points = stream.map(|s| match &frame {
-                        Some(frame) => frame.to_world(s.position),
-                        None => s.position,
-                    });
-                    return Ok(sink(&mut points));
-                }
-                _ => {}
+            let stream = engine::stream(&tiling, self.count).filter(|_| uniform);
+            if let Some(stream) = stream {
+                // the frame of `Rotated::new(density, seed)`
+                let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
+                let mut points = stream.map(|s| match &frame {
+                    Some(frame) => frame.to_world(s.position),
+                    None => s.position,
+                });
+                return Ok(sink(&mut points));
             }
         }
         if self.order == Order::Unsorted && self.within.is_none() && self.relax == 0 {
@@ -751,7 +734,7 @@ impl PlaneRequest {
 
     /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
     /// a uniform request on the unit square without seed streams block by
-    /// block in bounded memory where [`STREAM_ABOVE`] says so, an unsorted
+    /// block in bounded memory ([`engine::stream`]), an unsorted
     /// one a batch at a time ([`engine::unsorted`]). This is how `tessera
     /// plane` writes.
     ///
@@ -920,7 +903,7 @@ impl Tiling {
             tiling: &'a S,
             count: usize,
         ) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + 'a>> {
-            let stream = engine::stream(tiling, count).filter(worth_streaming)?;
+            let stream = engine::stream(tiling, count)?;
             Some(Box::new(stream.map(|s| s.position)))
         }
         match self {
@@ -928,9 +911,4 @@ impl Tiling {
             Tiling::Polyomino(tiling) => points(&**tiling, count),
         }
     }
-}
-
-/// Whether a uniform request streams (see [`STREAM_ABOVE`]).
-fn worth_streaming<S: TileSystem>(stream: &engine::Stream<'_, S>) -> bool {
-    stream.len() > STREAM_ABOVE || !stream.rebuilds_ancestors()
 }

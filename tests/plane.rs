@@ -752,3 +752,28 @@ fn unsorted_batches_equal_the_in_memory_unsorted_path() {
     check("penrose", &penrose, &Ramp, 700_000, true);
     check("penrose", &penrose, &image, 5000, false);
 }
+
+/// Levels deeper than the listed one (the G-hexomino's level 1, 17,496
+/// tiles; the P-pentomino's level 6, 81,920: see `tiling::code_order`)
+/// descend from it along each run's digits: every sample is its tile's,
+/// found from its root by the code's digits, across a run boundary.
+#[test]
+fn deep_code_order_samples_are_their_tiles_samples() {
+    let [(_, ghex), (_, ppent)] = systems();
+    for (tiling, run, level) in [(&ghex, 17_496, 3u32), (&ppent, 81_920, 9)] {
+        let codes = 5 * run - 300..5 * run + 300;
+        let (fraction, d) = (0.7, 0.7 * tiling.capacity(level));
+        let mut samples = Vec::new();
+        assert!(tiling.code_order_samples(level, codes.clone(), fraction, d, &mut samples));
+        assert_eq!(samples.len(), codes.len());
+        for (code, s) in codes.zip(&samples) {
+            let tile = tiling.tile_with_code(level, code as Code).unwrap();
+            assert_eq!(
+                s.position,
+                tiling.sample(&tile, fraction),
+                "level {level}, code {code}"
+            );
+            assert_eq!(s.rank, code as f64 / d);
+        }
+    }
+}

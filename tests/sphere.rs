@@ -415,3 +415,29 @@ fn unsorted_batches_equal_the_in_memory_unsorted_path() {
         }
     }
 }
+
+/// Levels deeper than the listed one (level 5, 245,760 tiles: see
+/// `tiling::code_order`) descend from it along each run's digits: every
+/// sample is its tile's, found from its root by the code's digits, across
+/// a run boundary.
+#[test]
+fn deep_code_order_samples_are_their_tiles_samples() {
+    let tiling = SphereTiling::default();
+    let run = 240 * 4usize.pow(5);
+    for level in [6u32, 8, 12] {
+        let codes = 3 * run - 300..3 * run + 300;
+        let (fraction, d) = (0.6, 0.6 * tiling.capacity(level));
+        let mut samples = Vec::new();
+        assert!(tiling.code_order_samples(level, codes.clone(), fraction, d, &mut samples));
+        assert_eq!(samples.len(), codes.len());
+        for (code, s) in codes.zip(&samples) {
+            let tile = tiling.tile_with_code(level, code as u128).unwrap();
+            assert_eq!(
+                s.position,
+                tiling.sample(&tile, fraction),
+                "level {level}, code {code}"
+            );
+            assert_eq!(s.rank, code as f64 / d);
+        }
+    }
+}

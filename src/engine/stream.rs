@@ -2,19 +2,16 @@
 //! and memory for one block whatever the count.
 
 use super::Sample;
-use crate::tiling::{code_value, Code, TileSystem};
+use crate::tiling::{code_order::CodeOrder, TileSystem};
 
-/// Codes computed at a time by a [`Stream`] (2 MB of sphere samples): the
-/// systems' block code shares a block out among threads, and each block
-/// recomputes the ancestors of its codes on every level with more tiles
-/// than a block has codes, so larger blocks cost fewer ancestors a sample
-/// (see `scripts/whole-process.sh` for what streaming costs).
+/// Codes computed at a time by a [`Stream`] (2 MB of sphere samples),
+/// shared out among threads.
 const STREAM_BLOCK: usize = 1 << 16;
 
 /// Uniform samples in progressive order, computed a block of
-/// 2^16 codes at a time ([`TileSystem::code_order_samples`]
-/// over consecutive code ranges, so they equal the in-memory path's sample
-/// for sample): memory stays one block however many are drawn.
+/// 2^16 codes at a time ([`TileSystem::code_order`] over consecutive code
+/// ranges, so they equal the in-memory path's sample for sample): memory
+/// stays one block (and the source's level list) however many are drawn.
 ///
 /// # Example
 /// ```
@@ -24,7 +21,7 @@ const STREAM_BLOCK: usize = 1 << 16;
 /// assert_eq!(first.len(), 3);
 /// ```
 pub struct Stream<'a, S: TileSystem> {
-    system: &'a S,
+    source: Box<dyn CodeOrder<S::Point> + 'a>,
     pub(super) level: u32,
     pub(super) fraction: f64,
     pub(super) d: f64,
@@ -49,11 +46,11 @@ pub struct Stream<'a, S: TileSystem> {
 pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> {
     let d = count as f64;
     let level = (0..=system.max_level()).find(|&l| system.capacity(l) >= d)?;
-    system.tile_with_code(level, 0)?;
+    let fraction = d / system.capacity(level);
     Some(Stream {
-        system,
+        source: system.code_order(level, 0..count, fraction, d)?,
         level,
-        fraction: d / system.capacity(level),
+        fraction,
         d,
         next: 0,
         end: count,
@@ -62,28 +59,6 @@ pub fn stream<S: TileSystem>(system: &S, count: usize) -> Option<Stream<'_, S>> 
     })
 }
 impl<S: TileSystem> Stream<'_, S> {
-    /// Whether each block rebuilds more than one level of ancestor tiles
-    /// that no other block shares. Where a level above the stream's has
-    /// more tiles than a block has codes, a block's ancestors on it are its
-    /// own (consecutive codes have consecutive, distinct parents), and a
-    /// stream builds them again for every block, while generating the
-    /// whole request at once builds every tile once. One such level (the
-    /// parents) costs little beside placing the samples; from two on, a
-    /// stream costs more a sample than the in-memory path.
-    ///
-    /// # Example
-    /// ```
-    /// use tessera::{engine, tiling::sphere::SphereTiling};
-    /// let sphere = SphereTiling::default();
-    /// assert!(!engine::stream(&sphere, 100_000).unwrap().rebuilds_ancestors());
-    /// assert!(engine::stream(&sphere, 10_000_000).unwrap().rebuilds_ancestors());
-    /// let hexomino = tessera::tiling::plane::PlaneTiling::ghexomino();
-    /// assert!(!engine::stream(&hexomino, 10_000_000).unwrap().rebuilds_ancestors());
-    /// ```
-    pub fn rebuilds_ancestors(&self) -> bool {
-        self.level > 1 && self.system.capacity(self.level - 2) > STREAM_BLOCK as f64
-    }
-
     /// Refills the block with the next codes; false at the end.
     fn refill(&mut self) -> bool {
         if self.next >= self.end {
@@ -92,19 +67,7 @@ impl<S: TileSystem> Stream<'_, S> {
         let codes = self.next..self.end.min(self.next.saturating_add(STREAM_BLOCK));
         self.next = codes.end;
         self.at = 0;
-        let (system, level, fraction, d) = (self.system, self.level, self.fraction, self.d);
-        let rank = |code: usize| code_value(code as Code) / d;
-        if !system.code_order_samples(level, codes.clone(), fraction, d, &mut self.block) {
-            // systems that find tiles only one at a time
-            self.block.clear();
-            self.block.extend(codes.map_while(|code| {
-                let tile = system.tile_with_code(level, code as Code)?;
-                Some(Sample {
-                    position: system.sample(&tile, fraction),
-                    rank: rank(code),
-                })
-            }));
-        }
+        self.source.fill(codes, &mut self.block);
         !self.block.is_empty()
     }
 }

@@ -72,6 +72,29 @@ pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std
     out.write_all(&(dims as u32).to_le_bytes())
 }
 
+/// Writes UTK binary's body: each point's `D` coordinates as little-endian
+/// f64, through a fixed buffer of 4096 points filled without bounds or
+/// capacity checks, so that a point costs its copies.
+fn write_utk_values<const D: usize>(
+    out: &mut impl Write,
+    mut points: impl Iterator<Item = [f64; D]>,
+) -> std::io::Result<()> {
+    let mut buffer = vec![0u8; 4096 * 8 * D];
+    loop {
+        let mut filled = 0;
+        for (slot, point) in buffer.chunks_exact_mut(8 * D).zip(&mut points) {
+            for (bytes, v) in slot.chunks_exact_mut(8).zip(point) {
+                bytes.copy_from_slice(&v.to_le_bytes());
+            }
+            filled += slot.len();
+        }
+        if filled == 0 {
+            return Ok(());
+        }
+        out.write_all(&buffer[..filled])?;
+    }
+}
+
 /// Writes sphere points in the given format; `pdf` is asked only for CSV
 /// and GeoJSON. A `lonlat` file starts with a `# lon lat (degrees)` line,
 /// which tells readers it from a planar `x y` file.
@@ -130,17 +153,7 @@ where
         }
         SphereFormat::Bin => {
             write_utk_header(out, points.len(), 3)?;
-            let mut buffer = Vec::with_capacity(24 << 12);
-            for p in points {
-                for v in [p.x, p.y, p.z] {
-                    buffer.extend_from_slice(&v.to_le_bytes());
-                }
-                if buffer.len() >= 24 << 12 {
-                    out.write_all(&buffer)?;
-                    buffer.clear();
-                }
-            }
-            out.write_all(&buffer)?;
+            write_utk_values(out, points.map(|p| [p.x, p.y, p.z]))?;
         }
     }
     Ok(())
@@ -489,16 +502,7 @@ where
         }
         PlaneFormat::Bin => {
             write_utk_header(out, points.len(), 2)?;
-            let mut buffer = Vec::with_capacity(16 << 12);
-            for p in points {
-                buffer.extend_from_slice(&p.x.to_le_bytes());
-                buffer.extend_from_slice(&p.y.to_le_bytes());
-                if buffer.len() >= 16 << 12 {
-                    out.write_all(&buffer)?;
-                    buffer.clear();
-                }
-            }
-            out.write_all(&buffer)?;
+            write_utk_values(out, points.map(|p| [p.x, p.y]))?;
         }
     }
     Ok(())

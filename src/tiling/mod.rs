@@ -4,12 +4,14 @@
 //! indices and offset tables; it knows nothing of densities or file formats.
 //! [`crate::engine`] drives any [`TileSystem`].
 
+pub mod code_order;
 pub mod penrose;
 pub mod plane;
 pub mod reference;
 pub mod sphere;
 
 use crate::sample::Sample;
+use code_order::CodeOrder;
 use std::ops::Range;
 
 /// A tile's threshold code (see [`TileSystem`]). 128 bits hold the codes of
@@ -147,14 +149,45 @@ pub trait TileSystem: Sync {
             })
             .collect()
     }
+    /// A source of the samples of the tiles of `level` whose codes lie in
+    /// `codes` (`0..count` is what a constant density of `d` samples per
+    /// domain accepts: density `fraction` of the level's capacity), ranked
+    /// `code / d`, in code order, over consecutive ranges (what a stream
+    /// asks for, block by block); `None` as
+    /// [`TileSystem::map_code_order`] would be. The default samples every
+    /// tile that method yields; systems override it to place points
+    /// without building the tiles' ancestors again for every range.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let mut source = sphere.code_order(2, 0..3000, 3000.0 / 3840.0, 3000.0).unwrap();
+    /// let mut s = Vec::new();
+    /// source.fill(1000..3000, &mut s);
+    /// assert_eq!(s[0].rank, 1000.0 / 3000.0);
+    /// ```
+    fn code_order(
+        &self,
+        level: u32,
+        codes: Range<usize>,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Box<dyn CodeOrder<Self::Point> + '_>> {
+        let fits = level <= self.max_level() && codes.end as f64 <= self.capacity(level);
+        (fits && self.tile_with_code(level, 0).is_some()).then(|| {
+            Box::new(ByMap {
+                system: self,
+                level,
+                fraction,
+                d,
+            }) as Box<dyn CodeOrder<Self::Point>>
+        })
+    }
     /// Writes into `out` (replacing its contents) the samples of the tiles
-    /// of `level` whose codes lie in `codes` (`0..count` is what a constant
-    /// density of `d` samples per domain accepts: density `fraction` of the
-    /// level's capacity), ranked `code / d`, in code order. False, leaving
-    /// `out` unspecified, as
-    /// [`TileSystem::map_code_order`] returns `None`. The default samples
-    /// every tile that method yields; systems override it to place points
-    /// without building whole tiles.
+    /// of `level` whose codes lie in `codes`, as one range of
+    /// [`TileSystem::code_order`]. False, leaving `out` unspecified, as
+    /// that method returns `None`.
     ///
     /// # Example
     /// ```
@@ -176,7 +209,8 @@ pub trait TileSystem: Sync {
         d: f64,
         out: &mut Vec<Sample<Self::Point>>,
     ) -> bool {
-        samples_in_code_order(self, level, codes, fraction, d, out)
+        let source = self.code_order(level, codes.clone(), fraction, d);
+        source.map(|mut source| source.fill(codes, out)).is_some()
     }
     /// Whether a terminal tile carries a sample. Penrose triangles only
     /// subdivide: its point tiles carry the samples.
@@ -221,30 +255,25 @@ pub(crate) fn mirror_unit(v: f64) -> f64 {
     w.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
 }
 
-/// [`TileSystem::code_order_samples`]'s default: every tile
-/// [`TileSystem::map_code_order`] yields, sampled into `out` (for systems
-/// that override the method and fall back to it).
-///
-/// # Example
-/// ```
-/// use tessera::tiling::{samples_in_code_order, sphere::SphereTiling};
-/// let mut s = Vec::new();
-/// assert!(samples_in_code_order(&SphereTiling::default(), 0, 0..3, 0.0125, 3.0, &mut s));
-/// assert_eq!(s.len(), 3);
-/// ```
-pub fn samples_in_code_order<S: TileSystem + ?Sized>(
-    system: &S,
+/// [`TileSystem::code_order`]'s default: every tile
+/// [`TileSystem::map_code_order`] yields, sampled.
+struct ByMap<'a, S: ?Sized> {
+    system: &'a S,
     level: u32,
-    codes: Range<usize>,
     fraction: f64,
     d: f64,
-    out: &mut Vec<Sample<S::Point>>,
-) -> bool {
-    let samples = system.map_code_order(level, codes, &|code, tile| Sample {
-        position: system.sample(tile, fraction),
-        rank: code_value(code) / d,
-    });
-    samples.map(|samples| *out = samples).is_some()
+}
+
+impl<S: TileSystem + ?Sized> CodeOrder<S::Point> for ByMap<'_, S> {
+    fn fill(&mut self, codes: Range<usize>, out: &mut Vec<Sample<S::Point>>) {
+        let (system, fraction, d) = (self.system, self.fraction, self.d);
+        let samples = system.map_code_order(self.level, codes, &|code, tile| Sample {
+            position: system.sample(tile, fraction),
+            rank: code_value(code) / d,
+        });
+        // in range: `code_order` checked
+        *out = samples.unwrap_or_default();
+    }
 }
 
 /// The digit blocks of base-A codes that `codes` meets, with `m` codes a

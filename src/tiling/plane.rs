@@ -16,9 +16,8 @@
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::polyomino::{Lattice, Orientation, Placement, Shape};
 use crate::sample::Sample;
-use crate::tiling::{
-    code_value, digit_blocks, mirror_unit, samples_in_code_order, span, Code, TileSystem,
-};
+use crate::tiling::code_order::{self, CodeOrder, Listed, Node, Subdivision};
+use crate::tiling::{code_value, digit_blocks, mirror_unit, span, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -448,10 +447,31 @@ impl PlaneTiling {
     }
 }
 
-/// The grandparent codes `k` that runs `(digit, first k, slots)` cover.
-fn span_of_runs<T>(runs: &[(usize, usize, &mut [T])]) -> Range<usize> {
-    let start = runs.iter().map(|r| r.1).min().unwrap_or(0);
-    start..runs.iter().map(|r| r.1 + r.2.len()).max().unwrap_or(start)
+impl Subdivision for PlaneTiling {
+    fn arity(&self) -> usize {
+        self.arity
+    }
+    fn scale(&self) -> Lattice {
+        self.scale
+    }
+    fn rules(&self) -> usize {
+        self.lut.rules.len()
+    }
+    fn classes(&self) -> usize {
+        self.lut.classes()
+    }
+    fn child_of_digit(&self, rule: usize, digit: usize) -> usize {
+        self.child_of_digit[rule * self.arity + digit] as usize
+    }
+    fn child_rule(&self, rule: usize, child: usize) -> usize {
+        self.child_rule[rule * self.arity + child] as usize
+    }
+    fn child_step(&self, rule: usize, child: usize) -> Placement {
+        self.lut.rules[rule].children[child]
+    }
+    fn child_class(&self, class: usize, child: usize) -> usize {
+        self.lut.transitions[class * self.arity + child] as usize
+    }
 }
 
 impl TileSystem for PlaneTiling {
@@ -573,30 +593,27 @@ impl TileSystem for PlaneTiling {
         Some(out)
     }
 
-    /// Places each point straight from its grandparent: the parents are
-    /// found on the fly and no tile is built for them or the points. Code
-    /// `d * m1 + e * m2 + k` (digits `d`, `e`; `m1`, `m2` the parent and
-    /// grandparent levels' tile counts) is child `d` of child `e` of
-    /// grandparent `k`, so each `(d, e)` is a run of `k` in the output,
-    /// written in order.
-    fn code_order_samples(
+    /// From a list of one level's tiles in code order (see
+    /// [`code_order`]), each point placed with the bin's offsets already
+    /// turned into each orientation (exact: the matrices are signed
+    /// permutations), so a point costs one lookup and no rotation.
+    fn code_order(
         &self,
         level: u32,
         codes: Range<usize>,
         fraction: f64,
         d: f64,
-        out: &mut Vec<Sample<DVec2>>,
-    ) -> bool {
-        if level < 2 || level > self.max_level || codes.end as f64 > self.capacity(level) {
-            return samples_in_code_order(self, level, codes, fraction, d, out);
+    ) -> Option<Box<dyn CodeOrder<DVec2> + '_>> {
+        if level > self.max_level || codes.end as f64 > self.capacity(level) {
+            return None;
         }
-        let (bin, s, a) = (
-            self.bin(fraction),
-            self.inv_size[level as usize],
-            self.arity,
-        );
-        // the bin's offsets in each orientation (exact: the matrices are
-        // signed permutations), so a point costs one lookup, no rotation
+        let listed = code_order::list_level(level, 0, |l| self.capacity(l));
+        let m = self.digit_weight[listed as usize] as usize;
+        let listed_codes = code_order::listed_codes(&codes, m);
+        let list = self.map_code_order(listed, listed_codes.clone(), &|_, t| {
+            Node::new(&t.placement, t.rule, t.class, 0)
+        })?;
+        let (bin, s) = (self.bin(fraction), self.inv_size[level as usize]);
         let turned: Vec<[f64; 2]> = self
             .offsets
             .iter()
@@ -604,67 +621,20 @@ impl TileSystem for PlaneTiling {
             .step_by(self.bins)
             .flat_map(|&offset| Orientation::ALL.map(|o| o.apply_f64(offset)))
             .collect();
-        let m1 = self.digit_weight[level as usize - 1] as usize;
-        let m2 = self.digit_weight[level as usize - 2] as usize;
-        // code `q * m2 + k` (q = d * a + e) is a run of `k` per `q`; the
-        // grandparents are those of every run the range meets
-        let runs_met = digit_blocks(&codes, m2);
-        let grand_codes = span(&runs_met);
-        let Some(grandparents) = self.map_code_order(level - 2, grand_codes.clone(), &|_, t| {
-            (t.placement, t.rule, t.class)
-        }) else {
-            return false;
-        };
-        let unset = Sample {
-            position: DVec2::ZERO,
-            rank: 0.0,
-        };
-        // (every slot is written below: only new memory needs a fill)
-        out.truncate(codes.len());
-        out.resize(codes.len(), unset);
-        // runs[e]: the output runs of the parents of digit `e`: per run its
-        // digit `d`, its first `k` and its slots
-        let mut runs: Vec<Vec<_>> = (0..a).map(|_| Vec::new()).collect();
-        let mut rest = &mut out[..];
-        for (q, within) in runs_met {
-            let (run, tail) = rest.split_at_mut(within.len());
-            rest = tail;
-            runs[q % a].push((q / a, within.start, run));
-        }
-        runs.into_par_iter().enumerate().for_each(|(e, mut runs)| {
-            let ks = span_of_runs(&runs);
-            for k in ks {
-                let (placement, rule, class) = &grandparents[k - grand_codes.start];
-                // the parent: child of digit `e`
-                let child = self.child_of_digit[*rule as usize * a + e] as usize;
-                let at = *rule as usize * a + child;
-                let parent = self.child_placement(placement, at);
-                let (rule, class) = (
-                    self.child_rule[at] as usize,
-                    self.lut.transitions[*class as usize * a + child] as usize,
-                );
-                for (digit, first, run) in runs.iter_mut() {
-                    let Some(slot) = k.checked_sub(*first).and_then(|i| run.get_mut(i)) else {
-                        continue;
-                    };
-                    let child = self.child_of_digit[rule * a + *digit] as usize;
-                    let placement = self.child_placement(&parent, rule * a + child);
-                    let class = self.lut.transitions[class * a + child] as usize;
-                    let (x, y) = placement.origin;
-                    let [dx, dy] = turned[class * 8 + placement.orientation.index()];
-                    // codes stay far below 2^53: exact as f64, as in the recursion
-                    let code = (*digit * m1 + e * m2 + k) as i64;
-                    *slot = Sample {
-                        position: DVec2::new(
-                            mirror_unit((x as f64 + dx) * s),
-                            mirror_unit((y as f64 + dy) * s),
-                        ),
-                        rank: code as f64 / d,
-                    };
-                }
+        let place = move |t: &code_order::Placed, code: usize| {
+            let (x, y) = t.placement.origin;
+            let [dx, dy] = turned[t.class as usize * 8 + t.placement.orientation.index()];
+            Sample {
+                position: DVec2::new(
+                    mirror_unit((x as f64 + dx) * s),
+                    mirror_unit((y as f64 + dy) * s),
+                ),
+                rank: code_value(code as Code) / d,
             }
-        });
-        true
+        };
+        let depth = level - listed;
+        let source = Listed::new(self, list, listed_codes.start, m, depth, place);
+        Some(Box::new(source))
     }
 
     fn tile_with_code(&self, level: u32, code: Code) -> Option<PlaneTile> {

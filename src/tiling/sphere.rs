@@ -15,6 +15,8 @@
 use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
 use crate::polyomino::{Lattice, Placement, Shape};
+use crate::sample::Sample;
+use crate::tiling::code_order::{self, CodeOrder, Listed, Node, Subdivision};
 use crate::tiling::{code_value, digit_blocks, span, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -262,8 +264,7 @@ impl SphereTiling {
         let m = self.capacity(level - 1) as usize;
         let blocks = digit_blocks(&codes, m);
         let parent_codes = span(&blocks);
-        let mut parents = TILE_LISTS.with(|lists| lists.borrow_mut().pop().unwrap_or_default());
-        parents.clear();
+        let mut parents = Vec::new();
         self.extend_in_code_order(level - 1, parent_codes.clone(), &mut parents, &|_, t| *t);
         out.reserve(codes.len());
         for (digit, within) in blocks {
@@ -272,9 +273,6 @@ impl SphereTiling {
                 &parents[within.start - parent_codes.start..within.end - parent_codes.start];
             let children = block.par_iter().with_min_len(4096).enumerate();
             out.par_extend(children.map(|(c, p)| f((start + c) as Code, &self.child_of(p, digit))));
-        }
-        if parents.capacity() <= KEPT_LIST_TILES {
-            TILE_LISTS.with(|lists| lists.borrow_mut().push(parents));
         }
     }
 
@@ -316,13 +314,8 @@ impl SphereTiling {
     /// assert!(fp.x > 0.0 && fp.x < 1.0 && fp.y > 0.0 && fp.y < 1.0);
     /// ```
     pub fn face_point(&self, tile: &SphereTile, local: [f64; 2]) -> FacePoint {
-        let lattice = tile.placement.to_lattice(local);
         let scale = 1.0 / Self::nside(tile.level as u32) as f64;
-        FacePoint::new(
-            tile.face,
-            (lattice[0] * scale).clamp(0.0, 1.0),
-            (lattice[1] * scale).clamp(0.0, 1.0),
-        )
+        on_face(tile.face, &tile.placement, scale, local)
     }
 
     /// The table offset (tile frame, cells) for a tile at the given density
@@ -352,18 +345,43 @@ impl SphereTiling {
     }
 }
 
-/// The longest tile list [`TILE_LISTS`] keeps (6 MB): a stream's blocks'
-/// lists, not a large in-memory request's, which are freed.
-const KEPT_LIST_TILES: usize = 1 << 17;
+/// The face point of a point given in the frame (cells) of a tile so
+/// placed on face `face`, on a lattice of `1 / scale` cells per face edge.
+#[inline(always)]
+fn on_face(face: u8, placement: &Placement, scale: f64, local: [f64; 2]) -> FacePoint {
+    let lattice = placement.to_lattice(local);
+    FacePoint::new(
+        face,
+        (lattice[0] * scale).clamp(0.0, 1.0),
+        (lattice[1] * scale).clamp(0.0, 1.0),
+    )
+}
 
-thread_local! {
-    /// Tile lists kept for [`SphereTiling::extend_in_code_order`]'s parents:
-    /// a stream asks for one block after another, and fresh lists cost
-    /// page faults (streaming 10^8 points spent more system time on them
-    /// than building the tiles took).
-    static TILE_LISTS: std::cell::RefCell<Vec<Vec<SphereTile>>> = const {
-        std::cell::RefCell::new(Vec::new())
-    };
+impl Subdivision for SphereTiling {
+    fn arity(&self) -> usize {
+        4
+    }
+    fn scale(&self) -> Lattice {
+        2
+    }
+    fn rules(&self) -> usize {
+        self.lut.rules.len()
+    }
+    fn classes(&self) -> usize {
+        self.lut.transitions.len()
+    }
+    fn child_of_digit(&self, rule: usize, digit: usize) -> usize {
+        self.child_of_digit[rule][digit] as usize
+    }
+    fn child_rule(&self, rule: usize, child: usize) -> usize {
+        self.lut.child_rule[rule][child] as usize
+    }
+    fn child_step(&self, rule: usize, child: usize) -> Placement {
+        self.lut.rules[rule].children[child]
+    }
+    fn child_class(&self, class: usize, child: usize) -> usize {
+        self.lut.transitions[class][child] as usize
+    }
 }
 
 impl TileSystem for SphereTiling {
@@ -455,6 +473,68 @@ impl TileSystem for SphereTiling {
         let mut out = Vec::new();
         self.extend_in_code_order(level, codes, &mut out, f);
         Some(out)
+    }
+
+    /// From a list of one level's tiles in code order (see
+    /// [`code_order`]), no shallower than the tree-indexed levels, so that
+    /// the classes descend by the automaton.
+    fn code_order(
+        &self,
+        level: u32,
+        codes: Range<usize>,
+        fraction: f64,
+        d: f64,
+    ) -> Option<Box<dyn CodeOrder<DVec3> + '_>> {
+        if level > MAX_LEVEL || codes.end as f64 > self.capacity(level) {
+            return None;
+        }
+        let exact = self.lut.exact_levels as u32;
+        let listed = code_order::list_level(level, exact, |l| self.capacity(l));
+        let m = self.capacity(listed) as usize;
+        let listed_codes = code_order::listed_codes(&codes, m);
+        let mut list = Vec::with_capacity(listed_codes.len());
+        self.extend_in_code_order(listed, listed_codes.clone(), &mut list, &|_, t| {
+            Node::new(&t.placement, t.rule, t.index, t.face)
+        });
+        // each class's offset at this fraction, looked up once, where the
+        // tiles' indices are classes (below, by tree position, per tile)
+        let tile = move |t: &code_order::Placed, code: usize| SphereTile {
+            face: t.face,
+            level: level as u8,
+            rule: t.rule,
+            placement: t.placement,
+            index: t.class,
+            code: code as Code,
+        };
+        let offsets: Vec<[f64; 2]> = match level >= exact {
+            true => (0..self.lut.transitions.len())
+                .map(|class| {
+                    let root = self.roots_by_code[0];
+                    let tile = SphereTile {
+                        level: level as u8,
+                        index: class as u32,
+                        ..root
+                    };
+                    self.offset(&tile, fraction)
+                })
+                .collect(),
+            false => Vec::new(),
+        };
+        let scale = 1.0 / Self::nside(level) as f64;
+        // what `sample` computes, from the offsets above
+        let place = move |t: &code_order::Placed, code: usize| {
+            let offset = match offsets.get(t.class as usize) {
+                Some(&offset) => offset,
+                None => self.offset(&tile(t, code), fraction),
+            };
+            Sample {
+                position: on_face(t.face, &t.placement, scale, offset).to_vec(),
+                rank: code_value(code as Code) / d,
+            }
+        };
+        let depth = level - listed;
+        let source = Listed::new(self, list, listed_codes.start, m, depth, place);
+        Some(Box::new(source))
     }
 
     fn tile_with_code(&self, level: u32, code: Code) -> Option<SphereTile> {
