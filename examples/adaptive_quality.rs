@@ -10,7 +10,7 @@
 //!     cargo run --release --example adaptive_quality [-- --out docs/SPHERE_ADAPTIVE.md]
 //!
 //! Options: `--out PATH` (default `docs/SPHERE_ADAPTIVE.md`), `--counts
-//! N,N,...` (default 20000,50000,200000), `--maps NAME,...` (generated
+//! N,N,...` (default 3072,20000,50000,200000), `--maps NAME,...` (generated
 //! skies by `tessera::synth::Sky::name`; default `smooth,clear-sky`).
 //! About 20 s at the defaults.
 
@@ -350,7 +350,7 @@ fn measure(case: &Case, n: usize) -> (Vec<Level>, usize) {
 
 fn main() {
     let mut out = String::from("docs/SPHERE_ADAPTIVE.md");
-    let mut counts = vec![20_000usize, 50_000, 200_000];
+    let mut counts = vec![3072usize, 20_000, 50_000, 200_000];
     let mut skies = vec![Sky::Smooth, Sky::ClearSky];
     let list: Vec<String> = std::env::args().skip(1).collect();
     let command = match list.is_empty() {
