@@ -451,7 +451,7 @@ fn contrast_edges_keep_planar_samples_spread() {
 
 /// A sun 5,000 times the sky (3x3 pixels of a 128x64 sky gradient): no
 /// pair closer than 0.25 of the local spacing at 1,000, 4,096 and 16,384
-/// samples (0.273, 0.287 and 0.255 with the table whose level 4 is per
+/// samples (0.328, 0.330 and 0.251 with the table whose level 4 is per
 /// tile; 0.328, 0.330 and 0.330 with the one before; the average-density
 /// rule before that gave 0.008, 0.006 and 0.005, samples leaked from the
 /// sun's rim tiles into the sky beside it).
