@@ -133,7 +133,7 @@ fn main() {
         }
     }
     let wall = start.elapsed().as_secs_f64();
-    let mut text = report(&rows, &command, wall, pairs_up_to);
+    let mut text = report(&rows, &command, wall, pairs_up_to, relax_up_to);
     text.push_str(&prefix_report(&prefixes));
     std::fs::write(&out, text).expect("write the report");
     eprintln!("wrote {out}");
@@ -155,6 +155,7 @@ fn report(
     command: &str,
     wall: f64,
     pairs_up_to: usize,
+    relax_up_to: usize,
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Uniform sphere quality at every count\n");
@@ -220,7 +221,10 @@ fn report(
         met(&|r| r.energy.is_some_and(|e| e <= -1.085)),
         tessera.iter().filter(|r| r.energy.is_some()).count(),
     );
-    let _ = writeln!(s, "\nA `-` is a measure not taken. Relaxation runs up to N = 10^6 (about 3.5 s an iteration there).\n");
+    let _ = writeln!(
+        s,
+        "\nA `-` is a measure not taken. Relaxation runs up to N = {relax_up_to}.\n"
+    );
     let _ = writeln!(s, "## Every count\n");
     let _ = writeln!(
         s,
