@@ -38,7 +38,7 @@ pub const LIST_TILES: usize = 1 << 18;
 /// assert_eq!(head.len() + tail.len(), 500);
 /// assert_eq!(tail[0].rank, 400.0 / 500.0);
 /// ```
-pub trait CodeOrder<P>: Send {
+pub trait CodeOrder<P>: Send + Sync {
     /// Replaces the contents of `out` with the samples of the codes
     /// `codes`, in code order, ranked `code / d` (`codes` within the range
     /// the source was made for).
