@@ -2,9 +2,9 @@
 //! spherical Fibonacci lattice, 10^7 points each into buffers kept between
 //! iterations (so no side pays for fresh pages), in one run. The library's
 //! Fibonacci (`baselines::spherical_fibonacci_into`, which reduces the
-//! azimuth in double-double) runs beside `plain_fibonacci`, the lattice
-//! written the obvious way, to check that the baseline is as fast as plain
-//! code. Whole-process timings (writing the points, against plain
+//! azimuth exactly, in 128-bit fixed point) runs beside `plain_fibonacci`,
+//! the lattice written the obvious way, to check that the baseline is as
+//! fast as plain code. Whole-process timings (writing the points, against plain
 //! programs) are `scripts/whole-process.sh`. Run: `cargo bench --bench
 //! sphere`.
 

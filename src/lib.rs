@@ -35,6 +35,7 @@
 pub mod accuracy;
 #[cfg(feature = "baselines")]
 pub mod baselines;
+pub mod blocks;
 pub mod density;
 pub mod engine;
 mod error;

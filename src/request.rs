@@ -17,6 +17,7 @@
 //! assert!(points.iter().all(|&p| pdf(p) > 0.0));
 //! ```
 
+use crate::blocks::{Blocks, IterBlocks};
 use crate::density::envmap::{EnvMap, Up};
 use crate::density::healpix::HealpixMap;
 use crate::density::plane::Shifted;
@@ -242,8 +243,8 @@ impl SphereRequest {
         }
     }
 
-    /// [`SphereRequest::points`] handed to `sink` as an exact-size
-    /// iterator: a uniform request (without window or relaxation) streams
+    /// [`SphereRequest::points`] handed to `sink` a block at a time
+    /// ([`Blocks`]): a uniform request (without window or relaxation) streams
     /// block by block in bounded memory ([`engine::stream`]), an
     /// unsorted one (without window or relaxation) a batch at a time
     /// ([`engine::unsorted`]); others are generated in memory first. This
@@ -254,13 +255,19 @@ impl SphereRequest {
     /// use tessera::request::{SphereDensity, SphereRequest};
     /// let uniform = SphereDensity::parse(&["uniform"]).unwrap();
     /// let request = SphereRequest { count: 1000, ..Default::default() };
-    /// let streamed: Vec<_> = request.with_points(&uniform, |points| points.collect()).unwrap();
+    /// let mut streamed = Vec::new();
+    /// request.with_points(&uniform, |points| {
+    ///     points.try_for_each_block(&mut |block| {
+    ///         streamed.extend_from_slice(block);
+    ///         Ok(())
+    ///     })
+    /// }).unwrap().unwrap();
     /// assert_eq!(streamed, request.points(&uniform).unwrap());
     /// ```
     pub fn with_points<R>(
         &self,
         density: &SphereDensity,
-        sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec3>) -> R,
+        sink: impl FnOnce(&mut dyn Blocks<DVec3>) -> R,
     ) -> Result<R, Error> {
         if let SphereDensity::Regions(d) = density {
             let tiling = self.tiling()?;
@@ -269,9 +276,9 @@ impl SphereRequest {
             if let Some(stream) = stream {
                 // the frame of `Rotated::new(density, seed)`
                 let frame = self.seed.map(|seed| Rotated::new(Uniform, seed));
-                let mut points = stream.map(|s| match &frame {
-                    Some(frame) => frame.to_world(s.position),
-                    None => s.position,
+                let mut points = stream.positions(|p| match &frame {
+                    Some(frame) => frame.to_world(p),
+                    None => p,
                 });
                 return Ok(sink(&mut points));
             }
@@ -284,7 +291,7 @@ impl SphereRequest {
             }
             impl<F, R> InFrame<SphereRegion> for Batches<'_, F>
             where
-                F: FnOnce(&mut dyn ExactSizeIterator<Item = DVec3>) -> R,
+                F: FnOnce(&mut dyn Blocks<DVec3>) -> R,
             {
                 type Out = Result<R, Error>;
                 fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
@@ -294,7 +301,9 @@ impl SphereRequest {
                 {
                     let (count, exact) = (self.request.count, !self.request.expected);
                     let samples = engine::unsorted(&self.tiling, density, count, exact)?;
-                    Ok((self.sink)(&mut samples.map(|s| to_world(s.position))))
+                    Ok((self.sink)(&mut IterBlocks::new(
+                        samples.map(|s| to_world(s.position)),
+                    )))
                 }
             }
             let tiling = self.tiling()?;
@@ -308,7 +317,7 @@ impl SphereRequest {
             );
         }
         let points = self.points(density)?;
-        Ok(sink(&mut points.into_iter()))
+        Ok(sink(&mut IterBlocks::new(points)))
     }
 
     /// The positions of `samples` (in `density`'s sampling frame), relaxed,
@@ -732,8 +741,8 @@ impl PlaneRequest {
         }
     }
 
-    /// [`PlaneRequest::points`] handed to `sink` as an exact-size iterator:
-    /// a uniform request on the unit square without seed streams block by
+    /// [`PlaneRequest::points`] handed to `sink` a block at a time
+    /// ([`Blocks`]): a uniform request on the unit square without seed streams block by
     /// block in bounded memory ([`engine::stream`]), an unsorted
     /// one a batch at a time ([`engine::unsorted`]). This is how `tessera
     /// plane` writes.
@@ -748,7 +757,7 @@ impl PlaneRequest {
     pub fn with_points<R>(
         &self,
         density: &dyn Density<PlaneRegion>,
-        sink: impl FnOnce(&mut dyn ExactSizeIterator<Item = DVec2>) -> R,
+        sink: impl FnOnce(&mut dyn Blocks<DVec2>) -> R,
     ) -> Result<R, Error> {
         let streams = density.constant().is_some() && self.domain.is_none() && self.seed.is_none();
         if streams {
@@ -768,7 +777,7 @@ impl PlaneRequest {
             impl<S, F, R> InFrame<PlaneRegion> for Batches<'_, S, F>
             where
                 S: TileSystem<Point = DVec2, Region = PlaneRegion>,
-                F: FnOnce(&mut dyn ExactSizeIterator<Item = DVec2>) -> R,
+                F: FnOnce(&mut dyn Blocks<DVec2>) -> R,
             {
                 type Out = Result<R, Error>;
                 fn run<D, W>(self, density: &D, to_world: W) -> Self::Out
@@ -777,7 +786,9 @@ impl PlaneRequest {
                     W: Fn(DVec2) -> DVec2,
                 {
                     let samples = engine::unsorted(self.tiling, density, self.count, self.exact)?;
-                    Ok((self.sink)(&mut samples.map(|s| to_world(s.position))))
+                    Ok((self.sink)(&mut IterBlocks::new(
+                        samples.map(|s| to_world(s.position)),
+                    )))
                 }
             }
             let (count, exact) = (self.count, !self.expected);
@@ -803,7 +814,7 @@ impl PlaneRequest {
             };
         }
         let points = self.points(density)?;
-        Ok(sink(&mut points.into_iter()))
+        Ok(sink(&mut IterBlocks::new(points)))
     }
 
     /// The pdf per unit area of the domain at a point of it, for samples
@@ -898,13 +909,13 @@ enum Tiling {
 
 impl Tiling {
     /// The tiling's uniform stream of `count` points, if it has one.
-    fn stream(&self, count: usize) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + '_>> {
+    fn stream(&self, count: usize) -> Option<Box<dyn Blocks<DVec2> + '_>> {
         fn points<'a, S: TileSystem<Point = DVec2>>(
             tiling: &'a S,
             count: usize,
-        ) -> Option<Box<dyn ExactSizeIterator<Item = DVec2> + 'a>> {
+        ) -> Option<Box<dyn Blocks<DVec2> + 'a>> {
             let stream = engine::stream(tiling, count)?;
-            Some(Box::new(stream.map(|s| s.position)))
+            Some(Box::new(stream.positions(|p| p)))
         }
         match self {
             Tiling::Penrose(tiling) => points(tiling, count),

@@ -67,7 +67,7 @@ use crate::tiling::TileSystem;
 use crate::Error;
 pub use batches::{unsorted, Unsorted};
 use ranking::{by_rank, smallest_ranks, RankBuckets};
-pub use stream::{stream, Stream};
+pub use stream::{stream, Positions, Stream};
 use walker::collect_parts;
 
 /// Every sample the tiling accepts when `magnitude` samples are expected

@@ -2,7 +2,9 @@
 //! and memory for one block whatever the count.
 
 use super::Sample;
+use crate::blocks::Blocks;
 use crate::tiling::{code_order::CodeOrder, TileSystem};
+use rayon::prelude::*;
 
 /// Codes computed at a time by a [`Stream`] (2 MB of sphere samples),
 /// shared out among threads.
@@ -91,3 +93,89 @@ impl<S: TileSystem> Iterator for Stream<'_, S> {
     }
 }
 impl<S: TileSystem> ExactSizeIterator for Stream<'_, S> {}
+
+impl<'a, S: TileSystem> Stream<'a, S> {
+    /// The stream's positions mapped by `to_world`, as [`Blocks`]: each
+    /// block is handed on while the next is computed (on another thread
+    /// of the pool, if it has one), so writing overlaps generation.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::{blocks::Blocks, engine, tiling::sphere::SphereTiling};
+    /// let tiling = SphereTiling::default();
+    /// let mut points = engine::stream(&tiling, 100_000).unwrap().positions(|p| -p);
+    /// let mut mirrored = Vec::new();
+    /// points.try_for_each_block(&mut |block| {
+    ///     mirrored.extend_from_slice(block);
+    ///     Ok(())
+    /// }).unwrap();
+    /// let samples = engine::stream(&tiling, 100_000).unwrap();
+    /// assert!(samples.map(|s| -s.position).eq(mirrored));
+    /// ```
+    pub fn positions<Q, F>(self, to_world: F) -> Positions<'a, S, F>
+    where
+        F: Fn(S::Point) -> Q + Sync,
+    {
+        Positions {
+            stream: self,
+            to_world,
+        }
+    }
+
+    /// Maps the samples of the block not yet yielded (the next block's,
+    /// if none is left) into `out`, and marks them yielded.
+    fn take_block<Q: Send>(
+        &mut self,
+        to_world: &(impl Fn(S::Point) -> Q + Sync),
+        out: &mut Vec<Q>,
+    ) {
+        out.clear();
+        if self.at >= self.block.len() && !self.refill() {
+            return;
+        }
+        out.par_extend(
+            self.block[self.at..]
+                .par_iter()
+                .with_min_len(4096)
+                .map(|s| to_world(s.position)),
+        );
+        self.at = self.block.len();
+    }
+}
+
+/// A [`Stream`]'s positions, mapped, a block at a time (see
+/// [`Stream::positions`]).
+pub struct Positions<'a, S: TileSystem, F> {
+    stream: Stream<'a, S>,
+    to_world: F,
+}
+
+impl<S, F, Q> Blocks<Q> for Positions<'_, S, F>
+where
+    S: TileSystem,
+    F: Fn(S::Point) -> Q + Sync,
+    Q: Send,
+{
+    fn len(&self) -> usize {
+        self.stream.len()
+    }
+
+    fn try_for_each_block(
+        &mut self,
+        f: &mut dyn FnMut(&[Q]) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        let (stream, to_world) = (&mut self.stream, &self.to_world);
+        let (mut current, mut next) = (Vec::new(), Vec::new());
+        stream.take_block(to_world, &mut current);
+        while !current.is_empty() {
+            let mut handed = Ok(());
+            rayon::in_place_scope(|scope| {
+                scope.spawn(|_| stream.take_block(to_world, &mut next));
+                handed = f(&current);
+            });
+            handed?;
+            std::mem::swap(&mut current, &mut next);
+        }
+        Ok(())
+    }
+}

@@ -5,6 +5,7 @@
 //! type byte 5 (f64) and three zero bytes, `u32` number of sets (1), `u32`
 //! point count, `u32` dimensions — then little-endian f64 values.
 
+use crate::blocks::{Blocks, IterBlocks};
 use crate::Error;
 use glam::DVec3;
 use std::io::{Read, Write};
@@ -73,26 +74,35 @@ pub fn write_utk_header(out: &mut impl Write, points: usize, dims: usize) -> std
 }
 
 /// Writes UTK binary's body: each point's `D` coordinates as little-endian
-/// f64, through a fixed buffer of 4096 points filled without bounds or
-/// capacity checks, so that a point costs its copies.
-fn write_utk_values<const D: usize>(
+/// f64, a block at a time through a fixed buffer of 4096 points filled
+/// without bounds or capacity checks, so that a point costs its copies.
+fn write_utk_values<P, const D: usize>(
     out: &mut impl Write,
-    mut points: impl Iterator<Item = [f64; D]>,
+    points: &mut dyn Blocks<P>,
+    coordinates: impl Fn(&P) -> [f64; D],
 ) -> std::io::Result<()> {
     let mut buffer = vec![0u8; 4096 * 8 * D];
-    loop {
-        let mut filled = 0;
-        for (slot, point) in buffer.chunks_exact_mut(8 * D).zip(&mut points) {
-            for (bytes, v) in slot.chunks_exact_mut(8).zip(point) {
-                bytes.copy_from_slice(&v.to_le_bytes());
+    points.try_for_each_block(&mut |block| {
+        for chunk in block.chunks(4096) {
+            let bytes = &mut buffer[..chunk.len() * 8 * D];
+            for (slot, point) in bytes.chunks_exact_mut(8 * D).zip(chunk) {
+                for (bytes, v) in slot.chunks_exact_mut(8).zip(coordinates(point)) {
+                    bytes.copy_from_slice(&v.to_le_bytes());
+                }
             }
-            filled += slot.len();
+            out.write_all(bytes)?;
         }
-        if filled == 0 {
-            return Ok(());
-        }
-        out.write_all(&buffer[..filled])?;
-    }
+        Ok(())
+    })
+}
+
+/// Writes text lines, one a point, a block at a time.
+fn write_lines<P>(
+    out: &mut impl Write,
+    points: &mut dyn Blocks<P>,
+    mut line: impl FnMut(&mut dyn Write, &P) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    points.try_for_each_block(&mut |block| block.iter().try_for_each(|p| line(out, p)))
 }
 
 /// Writes sphere points in the given format; `pdf` is asked only for CSV
@@ -116,47 +126,65 @@ where
     I: IntoIterator<Item = DVec3>,
     I::IntoIter: ExactSizeIterator,
 {
-    let points = points.into_iter();
+    write_sphere_blocks(out, &mut IterBlocks::new(points), format, pdf)
+}
+
+/// [`write_sphere`] of points handed on a block at a time (how the
+/// command line writes a stream).
+///
+/// # Example
+/// ```
+/// use tessera::{blocks::IterBlocks, io::points::{write_sphere_blocks, SphereFormat}};
+/// let mut out = Vec::new();
+/// let mut points = IterBlocks::new([glam::DVec3::X, glam::DVec3::Z]);
+/// write_sphere_blocks(&mut out, &mut points, SphereFormat::Bin, |_| 0.0).unwrap();
+/// assert_eq!(out.len(), 20 + 2 * 24);
+/// ```
+pub fn write_sphere_blocks(
+    out: &mut impl Write,
+    points: &mut dyn Blocks<DVec3>,
+    format: SphereFormat,
+    pdf: impl Fn(DVec3) -> f64,
+) -> std::io::Result<()> {
     match format {
-        SphereFormat::Xyz => {
-            for p in points {
-                writeln!(out, "{} {} {}", p.x, p.y, p.z)?;
-            }
-        }
+        SphereFormat::Xyz => write_lines(out, points, |out, p| {
+            writeln!(out, "{} {} {}", p.x, p.y, p.z)
+        }),
         SphereFormat::LonLat => {
             // the header tells a lon/lat file from a planar `x y` one
             writeln!(out, "{LONLAT_HEADER}")?;
-            for p in points {
+            write_lines(out, points, |out, &p| {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
-                writeln!(out, "{lon} {lat}")?;
-            }
+                writeln!(out, "{lon} {lat}")
+            })
         }
         SphereFormat::Csv => {
             writeln!(out, "x,y,z,lon,lat,pdf")?;
-            for p in points {
+            write_lines(out, points, |out, &p| {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
-                writeln!(out, "{},{},{},{lon},{lat},{}", p.x, p.y, p.z, pdf(p))?;
-            }
+                writeln!(out, "{},{},{},{lon},{lat},{}", p.x, p.y, p.z, pdf(p))
+            })
         }
         SphereFormat::GeoJson => {
             write!(out, "{{\"type\":\"FeatureCollection\",\"features\":[")?;
-            for (k, p) in points.enumerate() {
+            let mut sep = "";
+            write_lines(out, points, |out, &p| {
                 let (lon, lat) = crate::healpix::lonlat_deg(p);
-                let sep = if k == 0 { "" } else { "," };
                 write!(
                     out,
                     "{sep}\n{{\"type\":\"Feature\",\"geometry\":{{\"type\":\"Point\",\"coordinates\":[{lon},{lat}]}},\"properties\":{{\"pdf\":{}}}}}",
                     json_number(pdf(p))
                 )?;
-            }
-            writeln!(out, "\n]}}")?;
+                sep = ",";
+                Ok(())
+            })?;
+            writeln!(out, "\n]}}")
         }
         SphereFormat::Bin => {
             write_utk_header(out, points.len(), 3)?;
-            write_utk_values(out, points.map(|p| [p.x, p.y, p.z]))?;
+            write_utk_values(out, points, |p| [p.x, p.y, p.z])
         }
     }
-    Ok(())
 }
 
 /// A number as JSON has it: non-finite values become `null`.
@@ -487,23 +515,37 @@ where
     I: IntoIterator<Item = glam::DVec2>,
     I::IntoIter: ExactSizeIterator,
 {
-    let points = points.into_iter();
+    write_plane_blocks(out, &mut IterBlocks::new(points), format, pdf)
+}
+
+/// [`write_plane`] of points handed on a block at a time (how the command
+/// line writes a stream).
+///
+/// # Example
+/// ```
+/// use tessera::{blocks::IterBlocks, io::points::{write_plane_blocks, PlaneFormat}};
+/// let mut out = Vec::new();
+/// let mut points = IterBlocks::new([glam::DVec2::new(0.5, 0.25)]);
+/// write_plane_blocks(&mut out, &mut points, PlaneFormat::Txt, |_| 1.0).unwrap();
+/// assert_eq!(String::from_utf8(out).unwrap(), "0.5 0.25\n");
+/// ```
+pub fn write_plane_blocks(
+    out: &mut impl Write,
+    points: &mut dyn Blocks<glam::DVec2>,
+    format: PlaneFormat,
+    pdf: impl Fn(glam::DVec2) -> f64,
+) -> std::io::Result<()> {
     match format {
-        PlaneFormat::Txt => {
-            for p in points {
-                writeln!(out, "{} {}", p.x, p.y)?;
-            }
-        }
+        PlaneFormat::Txt => write_lines(out, points, |out, p| writeln!(out, "{} {}", p.x, p.y)),
         PlaneFormat::Csv => {
             writeln!(out, "x,y,pdf")?;
-            for p in points {
-                writeln!(out, "{},{},{}", p.x, p.y, pdf(p))?;
-            }
+            write_lines(out, points, |out, &p| {
+                writeln!(out, "{},{},{}", p.x, p.y, pdf(p))
+            })
         }
         PlaneFormat::Bin => {
             write_utk_header(out, points.len(), 2)?;
-            write_utk_values(out, points.map(|p| [p.x, p.y]))?;
+            write_utk_values(out, points, |p| [p.x, p.y])
         }
     }
-    Ok(())
 }

@@ -69,7 +69,7 @@ pub(crate) fn plane(args: PlaneArgs) -> Result<(), Error> {
     let output = &args.request.output;
     request.with_points(&*density, |points| {
         let mut out = create(output)?;
-        tessera::io::points::write_plane(&mut out, points, format, &pdf)
+        tessera::io::points::write_plane_blocks(&mut out, points, format, &pdf)
             .and_then(|()| out.flush())
             .map_err(io_error(output))
     })?

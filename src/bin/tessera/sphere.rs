@@ -5,6 +5,7 @@ use clap::builder::PossibleValuesParser;
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use tessera::blocks::{Blocks, IterBlocks};
 use tessera::density::sphere::Cap;
 use tessera::io::points::SphereFormat;
 use tessera::Error;
@@ -105,9 +106,9 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
     };
     let pdf = density.pdf();
     let output = &args.request.output;
-    let write = |points: &mut dyn ExactSizeIterator<Item = glam::DVec3>| {
+    let write = |points: &mut dyn Blocks<glam::DVec3>| {
         let mut out = create(output)?;
-        tessera::io::points::write_sphere(&mut out, points, format, &pdf)
+        tessera::io::points::write_sphere_blocks(&mut out, points, format, &pdf)
             .and_then(|()| out.flush())
             .map_err(io_error(output))
     };
@@ -131,7 +132,7 @@ pub(crate) fn sphere(args: SphereArgs) -> Result<(), Error> {
             );
         }
         print_report(&points, &pdf);
-        write(&mut points.into_iter())
+        write(&mut IterBlocks::new(points))
     } else {
         request.with_points(&density, write)?
     }
