@@ -14,6 +14,8 @@
 //! skies by `tessera::synth::Sky::name`; default `smooth,clear-sky`).
 //! About 20 s at the defaults.
 
+mod args;
+
 use glam::DVec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::collections::BTreeMap;
@@ -352,14 +354,7 @@ fn main() {
     let mut out = String::from("docs/SPHERE_ADAPTIVE.md");
     let mut counts = vec![3072usize, 20_000, 50_000, 200_000];
     let mut skies = vec![Sky::Smooth, Sky::ClearSky];
-    let list: Vec<String> = std::env::args().skip(1).collect();
-    let command = match list.is_empty() {
-        true => "cargo run --release --example adaptive_quality".to_string(),
-        false => format!(
-            "cargo run --release --example adaptive_quality -- {}",
-            list.join(" ")
-        ),
-    };
+    let (command, list) = args::command_line("adaptive_quality");
     let mut it = list.into_iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().unwrap_or_else(|| panic!("{a} needs a value"));

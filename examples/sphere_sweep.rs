@@ -10,6 +10,8 @@
 //! `--relax-up-to N` (default 10^6), `--large` (adds 10^7, tessera and
 //! Fibonacci only: about a minute more).
 
+mod args;
+
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -62,14 +64,7 @@ const METHODS: [&str; 6] = [
 fn main() {
     let mut out = String::from("docs/SPHERE_SWEEP.md");
     let (mut pairs_up_to, mut relax_up_to, mut large) = (100_000usize, 1_000_000usize, false);
-    let list: Vec<String> = std::env::args().skip(1).collect();
-    let command = match list.is_empty() {
-        true => "cargo run --release --example sphere_sweep".to_string(),
-        false => format!(
-            "cargo run --release --example sphere_sweep -- {}",
-            list.join(" ")
-        ),
-    };
+    let (command, list) = args::command_line("sphere_sweep");
     let mut it = list.into_iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().unwrap_or_else(|| panic!("{a} needs a value"));
