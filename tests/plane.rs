@@ -228,6 +228,47 @@ fn streaming_recursion_and_the_uniform_fast_path_agree() {
     }
 }
 
+#[test]
+fn streamed_blocks_are_the_stream_and_write_the_same_bytes() {
+    use tessera::blocks::{Blocks, IterBlocks};
+    use tessera::io::points::{write_plane, write_plane_blocks, PlaneFormat};
+    for (system, tiling) in systems() {
+        // one block, a block and one point, several blocks
+        for n in [1usize, 65_537, 200_000] {
+            let expected: Vec<DVec2> = engine::stream(&tiling, n)
+                .unwrap()
+                .map(|s| s.position)
+                .collect();
+            let mut blocks = engine::stream(&tiling, n).unwrap().positions(|p| p);
+            assert_eq!(blocks.len(), n);
+            let mut handed = Vec::new();
+            blocks
+                .try_for_each_block(&mut |block| {
+                    handed.extend_from_slice(block);
+                    Ok(())
+                })
+                .unwrap();
+            assert_eq!(handed, expected, "{system:?}, n = {n}");
+            for format in [PlaneFormat::Bin, PlaneFormat::Txt] {
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                write_plane(&mut a, expected.iter().copied(), format, |_| 1.0).unwrap();
+                let mut points = engine::stream(&tiling, n).unwrap().positions(|p| p);
+                write_plane_blocks(&mut b, &mut points, format, |_| 1.0).unwrap();
+                assert!(a == b, "{system:?}, n = {n}, {format:?}");
+                let mut c = Vec::new();
+                write_plane_blocks(
+                    &mut c,
+                    &mut IterBlocks::new(expected.iter().copied()),
+                    format,
+                    |_| 1.0,
+                )
+                .unwrap();
+                assert!(a == c, "{system:?}, n = {n}, {format:?}");
+            }
+        }
+    }
+}
+
 /// A density with no mass, which every request refuses.
 struct Zero;
 
