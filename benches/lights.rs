@@ -39,8 +39,8 @@ fn to_lights(c: &mut Criterion) {
     group.bench_function("load_only", |b| {
         b.iter(|| one.install(|| black_box(load(&path))))
     });
-    let default_steps = LightOptions::default().lloyd_steps;
-    for steps in [0, 3, 6, 10] {
+    let default_steps = tessera::lights::default_lloyd_steps(N);
+    for steps in [0, 3, 6, 8, 10] {
         let label = if steps == default_steps {
             format!("tessera_lloyd_{steps}_default")
         } else {
@@ -52,7 +52,7 @@ fn to_lights(c: &mut Criterion) {
                     let (rgb, map) = load(&path);
                     let options = LightOptions {
                         rgb: Some(&rgb),
-                        lloyd_steps: steps,
+                        lloyd_steps: Some(steps),
                         ..Default::default()
                     };
                     black_box(lights(&map, N, &options).expect("lights"))

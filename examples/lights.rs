@@ -23,7 +23,7 @@
 //! error over seeded frames and the accuracy of the cells
 //! (`--no-quadrature` skips it); `--map-seed` generates the main maps from
 //! another seed (1 by default); `--held-out` repeats the summary on the
-//! maps of seeds 2 and 3; `--write` writes docs/LIGHTS.md and docs/img/lights.png
+//! maps of seeds 2-7 (4-7 held out from the choice of the defaults); `--write` writes docs/LIGHTS.md and docs/img/lights.png
 //! (`--write --sweep --held-out` is the full document); `--quick` runs only
 //! the unrotated maps; `--exponent`, `--cap`, `--lloyd`, `--tolerance`
 //! override tessera's defaults in the tables.
@@ -43,8 +43,12 @@ use tessera::synth::{Sky, SynthMap};
 const W: usize = 1024;
 const H: usize = 512;
 const COUNTS: [usize; 9] = [64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384];
-/// The maps' seeds of the held-out checks (`--held-out`).
-const HELD_OUT: [u64; 2] = [2, 3];
+/// The maps' seeds of the held-out checks (`--held-out`): seeds 2 and 3
+/// also served in choosing the per-N defaults (`default_exponent`,
+/// `default_lloyd_steps`), seeds 4-7 never did.
+const HELD_OUT: [u64; 6] = [2, 3, 4, 5, 6, 7];
+/// The held-out seeds that also served in choosing the defaults.
+const TUNED_ON: [u64; 2] = [2, 3];
 const SKIES: [Sky; 4] = [Sky::ClearSky, Sky::Overcast, Sky::CityNight, Sky::Interior];
 
 /// The method paragraph of docs/LIGHTS.md.
@@ -265,7 +269,7 @@ struct Args {
     no_quadrature: bool,
     map_seed: u64,
     configs: Option<Vec<(Option<f64>, f64, LloydWeight)>>,
-    steps: Option<Vec<usize>>,
+    steps: Option<Vec<Option<usize>>>,
     counts: Option<Vec<usize>>,
     options: LightOptions<'static>,
 }
@@ -326,10 +330,15 @@ fn args() -> Args {
             }
             "--steps" => {
                 let list = it.next().expect("--steps needs a list");
-                a.steps = Some(list.split(',').map(|k| k.parse().expect("steps")).collect());
+                // `auto`: the per-N default (`default_lloyd_steps`)
+                a.steps = Some(
+                    list.split(',')
+                        .map(|k| (k != "auto").then(|| k.parse().expect("steps")))
+                        .collect(),
+                );
             }
             "--exponent" => a.options.exponent = Some(value("--exponent")),
-            "--lloyd" => a.options.lloyd_steps = value("--lloyd") as usize,
+            "--lloyd" => a.options.lloyd_steps = Some(value("--lloyd") as usize),
             "--tolerance" => a.options.tolerance = value("--tolerance"),
             "--cap" => a.options.pixel_cap = value("--cap"),
             other => panic!("unknown argument {other}"),
@@ -379,8 +388,8 @@ fn main() {
         if let Some(e) = args.options.exponent {
             let _ = write!(c, " --exponent {e}");
         }
-        if args.options.lloyd_steps != d.lloyd_steps {
-            let _ = write!(c, " --lloyd {}", args.options.lloyd_steps);
+        if let Some(k) = args.options.lloyd_steps {
+            let _ = write!(c, " --lloyd {k}");
         }
         if args.options.pixel_cap != d.pixel_cap {
             let _ = write!(c, " --cap {}", args.options.pixel_cap);
@@ -419,14 +428,26 @@ fn main() {
             let held = build_cases(seed, &frames, &probes);
             let _ = writeln!(
                 doc,
-                "\n# Held out: the same maps generated from seed {seed}\n\nThe defaults were chosen on the seed-{} maps above; the same comparison on the maps of seed {seed} (another sun position, other lights, lamps and texture), in the same frames:\n",
-                args.map_seed
+                "\n# {}: the same maps generated from seed {seed}\n\nThe same comparison on the maps of seed {seed} (another sun position, other lights, lamps and texture), in the same frames. {}\n",
+                if TUNED_ON.contains(&seed) { "Checked" } else { "Held out" },
+                if TUNED_ON.contains(&seed) {
+                    "The per-N exponent and Lloyd steps were chosen on the maps of seeds 1-3, so this seed is not held out."
+                } else {
+                    "No default was chosen on this seed: a held-out check."
+                }
             );
             tables(
                 &held,
                 &probes,
                 &args.options,
-                &format!("Held-out summary, seed {seed}"),
+                &format!(
+                    "{} summary, seed {seed}",
+                    if TUNED_ON.contains(&seed) {
+                        "Check"
+                    } else {
+                        "Held-out"
+                    }
+                ),
                 false,
                 &mut doc,
             );
@@ -502,10 +523,10 @@ fn tables(
     );
     let _ = writeln!(
         doc,
-        "Options: exponent {}, pixel cap {}, {} Lloyd step(s), tolerance {}. Each cell: diffuse / glossy 10 / glossy 100; bold where tessera is worse.\n",
+        "Options: exponent {}, pixel cap {}, Lloyd steps {}, tolerance {}. Each cell: diffuse / glossy 10 / glossy 100; bold where tessera is worse.\n",
         options.exponent.map_or("per N (`default_exponent`)".to_string(), |e| e.to_string()),
         options.pixel_cap,
-        options.lloyd_steps,
+        steps_label(options.lloyd_steps),
         options.tolerance
     );
     let mut header = String::from("| map / frame |");
@@ -607,12 +628,12 @@ fn tables(
 fn bench_times(doc: &mut String) {
     let target = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".to_string());
     let dir = std::path::Path::new(&target).join("criterion/lights_1024x512_n4096_1_thread");
-    let default_steps = LightOptions::default().lloyd_steps;
+    let default_steps = tessera::lights::default_lloyd_steps(4096);
     let mut names = vec![(
         "load_only".to_string(),
         "reading the EXR (colour and importance) only".to_string(),
     )];
-    for k in [0, 3, 6, 10] {
+    for k in [0, 3, 6, 8, 10] {
         let (name, what) = if k == default_steps {
             (
                 format!("tessera_lloyd_{k}_default"),
@@ -671,7 +692,12 @@ fn bench_times(doc: &mut String) {
 
 /// A sweep entry's exponent, cap, Lloyd weight and steps, and its summed
 /// log ratios per N.
-type SweepRow = (String, f64, &'static str, usize, Vec<[f64; 3]>);
+type SweepRow = (String, f64, &'static str, String, Vec<[f64; 3]>);
+
+/// A Lloyd step count as the tables show it (`per N` for the default).
+fn steps_label(steps: Option<usize>) -> String {
+    steps.map_or("per N".to_string(), |k| k.to_string())
+}
 
 /// The measurements behind the default exponent, pixel cap and Lloyd steps.
 fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
@@ -682,7 +708,10 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
         (None, 1.0, LloydWeight::DrawnSquared),
     ];
     let configs = args.configs.clone().unwrap_or(default_configs.to_vec());
-    let steps = args.steps.clone().unwrap_or(vec![0usize, 3, 6, 10]);
+    let steps = args
+        .steps
+        .clone()
+        .unwrap_or(vec![Some(0), Some(6), Some(20), None]);
     let counts = args
         .counts
         .clone()
@@ -717,7 +746,8 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
     let _ = writeln!(doc, "|---:|---:|---|---:|---:|---:|---:|---:|---:|");
     let mut per_n: Vec<SweepRow> = Vec::new();
     for &(e, cap, weight) in &configs {
-        for &k in &steps {
+        for &steps in &steps {
+            let k = steps_label(steps);
             let name = e.map_or("per N".to_string(), |e| e.to_string());
             let wname = match weight {
                 LloydWeight::DrawnSquared => "drawn^2",
@@ -726,7 +756,7 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
             let options = LightOptions {
                 exponent: e,
                 pixel_cap: cap,
-                lloyd_steps: k,
+                lloyd_steps: steps,
                 lloyd_weight: weight,
                 ..Default::default()
             };

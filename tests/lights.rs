@@ -60,7 +60,7 @@ fn powers_partition_the_map_exactly() {
             for lloyd_steps in [0, 2] {
                 let options = LightOptions {
                     rgb: Some(&rgb),
-                    lloyd_steps,
+                    lloyd_steps: Some(lloyd_steps),
                     ..Default::default()
                 };
                 let l = lights(&map, n, &options).unwrap();
@@ -110,7 +110,7 @@ fn exactly_n_lights_on_a_sparse_map() {
         for lloyd_steps in [0, 1, 3] {
             let options = LightOptions {
                 rgb: Some(&rgb),
-                lloyd_steps,
+                lloyd_steps: Some(lloyd_steps),
                 ..Default::default()
             };
             let l = lights(&map, n, &options).unwrap();
@@ -203,7 +203,7 @@ fn cells_match_brute_force_voronoi() {
         let options = LightOptions {
             exponent: Some(1.0),
             pixel_cap: f64::INFINITY,
-            lloyd_steps: 0,
+            lloyd_steps: Some(0),
             tolerance,
             ..Default::default()
         };
@@ -239,7 +239,7 @@ fn results_do_not_depend_on_the_thread_count() {
     let map = rgb.env_map(Up::Z).unwrap();
     let options = LightOptions {
         rgb: Some(&rgb),
-        lloyd_steps: 1,
+        lloyd_steps: Some(1),
         ..Default::default()
     };
     let one = on_threads(1, || lights(&map, 500, &options).unwrap());
@@ -295,7 +295,7 @@ fn lloyd_steps_lower_the_quantisation_energy() {
     let energy = |steps: usize| {
         // the map-weighted iteration is Lloyd's for this energy
         let options = LightOptions {
-            lloyd_steps: steps,
+            lloyd_steps: Some(steps),
             lloyd_weight: LloydWeight::Map,
             ..Default::default()
         };
@@ -337,7 +337,7 @@ fn drawn_squared_lloyd_steps_keep_the_drawn_spread() {
         let options = LightOptions {
             exponent: Some(1.0),
             pixel_cap: f64::INFINITY,
-            lloyd_steps: steps,
+            lloyd_steps: Some(steps),
             lloyd_weight: weight,
             ..Default::default()
         };
@@ -407,7 +407,7 @@ fn bad_requests_are_refused() {
         (
             4,
             LightOptions {
-                lloyd_steps: 101,
+                lloyd_steps: Some(101),
                 ..d
             },
             "Lloyd",

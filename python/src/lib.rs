@@ -522,7 +522,7 @@ fn lights<'py>(
     strict: bool,
     seed: Option<u64>,
     exponent: Option<f64>,
-    lloyd: usize,
+    lloyd: Option<usize>,
     threads: Option<usize>,
 ) -> PyResult<LightsOut<'py>> {
     let up = up_axis(up)?;

@@ -528,7 +528,7 @@ def plane(
     return (points, pdfs) if pdf else points
 
 
-def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=None, lloyd=6, threads=None):
+def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=None, lloyd=None, threads=None):
     """An environment map as n directional lights with exact powers.
 
     What ``tessera lights --map MAP -n N`` writes, as a dict of arrays:
@@ -547,10 +547,11 @@ def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=No
         Number of lights (exactly).
     up, channel, strict, seed, threads : as for ``sphere``.
     exponent : float, optional
-        Directions follow value**exponent (default: a rule of n, 0.625 at
-        n <= 64, 0.875 at 256-1024, 0.95 from 4096).
-    lloyd : int
-        Lloyd steps after the first cut.
+        Directions follow value**exponent (default: a rule of n, 0.2 at
+        n <= 64 rising to 0.875 at 256-1024 and 0.95 from 4096).
+    lloyd : int, optional
+        Lloyd steps after the first cut (default: a rule of n, 10 at
+        n <= 128, 20 at 256-1024, 8 from 4096).
 
     Examples
     --------
@@ -576,7 +577,7 @@ def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=No
         bool(strict),
         _seed(seed),
         None if exponent is None else float(exponent),
-        _count(lloyd, "lloyd"),
+        None if lloyd is None else _count(lloyd, "lloyd"),
         _threads(threads),
     )
     _warn(notes)

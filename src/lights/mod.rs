@@ -8,7 +8,7 @@
 //! directions' spherical Voronoi cells and gives each light its cell's
 //! power, the integral of each channel over the cell (map units x
 //! steradians), placed at the cell's luminance-weighted mean direction.
-//! Lloyd steps (6 by default) first even the cells' shapes: each re-cuts
+//! Lloyd steps (8 to 20 by default, see [`default_lloyd_steps`]) first even the cells' shapes: each re-cuts
 //! the sphere around the cells' mean directions and re-centres, weighted
 //! by the square of the drawn density so that the steps keep the drawn
 //! spread (a Lloyd iteration weighted by the map itself would drift to
@@ -255,7 +255,7 @@ pub fn read_rgb(path: &Path, options: &ReadOptions) -> Result<(RgbMap, Raster), 
 /// ```
 /// let o = tessera::lights::LightOptions::default();
 /// assert!(o.rgb.is_none() && o.seed.is_none());
-/// assert!(o.rgb.is_none() && o.exponent.is_none() && o.lloyd_steps == 6);
+/// assert!(o.rgb.is_none() && o.exponent.is_none() && o.lloyd_steps.is_none());
 /// assert!(o.table.is_none());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -277,8 +277,9 @@ pub struct LightOptions<'a> {
     /// and re-centres, for one more pass over a grid of blocks of up to
     /// 8 x 8 pixels, at least 32 blocks per light (see [`LloydWeight`];
     /// about 40 ms on one thread for a 1024 x 512 map at `n = 4096`,
-    /// docs/LIGHTS.md); at most 100.
-    pub lloyd_steps: usize,
+    /// docs/LIGHTS.md); at most 100. `None` takes
+    /// [`default_lloyd_steps`] of the light count.
+    pub lloyd_steps: Option<usize>,
     /// Split boundary pixels until a piece holds at most this fraction of
     /// an average light's power (`integral / n`) and solid angle
     /// (`4 pi / n`), in the last pass (earlier passes use `max(tolerance,
@@ -320,26 +321,80 @@ pub enum LloydWeight {
 }
 
 /// The density exponent for `n` lights when none is given, piecewise
-/// linear in `log2 n`: 0.625 up to `n = 64`, 0.875 from 256 to 1024, 0.95
-/// from 4096 on. Few lights must cover the sphere (narrow lobes anywhere
-/// need a light near them: a flatter density); many lights want cells of
-/// equal power, where the leading second-order error of every smooth
-/// integrand cancels (the exponent towards 1). The breakpoints were chosen
-/// by measurement; see docs/LIGHTS.md.
+/// linear in `log2 n` between [`EXPONENT_KNOTS`]. Few lights must cover
+/// the sphere (a narrow lobe anywhere needs a light near it: a flat
+/// density); many lights want cells of equal power, where the leading
+/// second-order error of every smooth integrand cancels (the exponent
+/// towards 1). The knots were chosen by measurement on the maps of seeds
+/// 1-3 and checked on seeds 4-7; see docs/LIGHTS.md.
 ///
 /// # Example
 /// ```
 /// use tessera::lights::default_exponent;
-/// assert_eq!(default_exponent(16), 0.625);
-/// assert!((default_exponent(128) - 0.75).abs() < 1e-12);
-/// assert_eq!(default_exponent(512), 0.875);
+/// assert_eq!(default_exponent(16), 0.2);
+/// assert_eq!(default_exponent(256), 0.875);
 /// assert!((default_exponent(2048) - 0.9125).abs() < 1e-12);
 /// assert_eq!(default_exponent(1 << 20), 0.95);
 /// ```
 pub fn default_exponent(n: usize) -> f64 {
+    piecewise(&EXPONENT_KNOTS, n)
+}
+
+/// `(log2 n, exponent)` knots of [`default_exponent`], constant outside.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::lights::EXPONENT_KNOTS[0], (6.0, 0.2));
+/// ```
+pub const EXPONENT_KNOTS: [(f64, f64); 6] = [
+    (6.0, 0.2),
+    (7.0, 0.625),
+    (8.0, 0.875),
+    (9.0, 0.8),
+    (10.0, 0.875),
+    (12.0, 0.95),
+];
+
+/// The Lloyd steps for `n` lights when none are given, piecewise linear
+/// in `log2 n` between [`LLOYD_KNOTS`] and rounded: a few hundred lights
+/// gain from 20 steps, while at 4096 lights and more the gain of a step
+/// no longer pays its cost (about 40 ms on one thread at 4096 lights on a
+/// 1024 x 512 map; docs/LIGHTS.md).
+///
+/// # Example
+/// ```
+/// use tessera::lights::default_lloyd_steps;
+/// assert_eq!(default_lloyd_steps(64), 10);
+/// assert_eq!(default_lloyd_steps(512), 20);
+/// assert_eq!(default_lloyd_steps(2048), 14);
+/// assert_eq!(default_lloyd_steps(1 << 20), 8);
+/// ```
+pub fn default_lloyd_steps(n: usize) -> usize {
+    piecewise(&LLOYD_KNOTS, n).round() as usize
+}
+
+/// `(log2 n, steps)` knots of [`default_lloyd_steps`], constant outside.
+///
+/// # Example
+/// ```
+/// assert_eq!(tessera::lights::LLOYD_KNOTS.last(), Some(&(12.0, 8.0)));
+/// ```
+pub const LLOYD_KNOTS: [(f64, f64); 4] = [(7.0, 10.0), (8.0, 20.0), (10.0, 20.0), (12.0, 8.0)];
+
+/// Linear interpolation in `log2 n` between sorted knots, constant
+/// outside them.
+fn piecewise(knots: &[(f64, f64)], n: usize) -> f64 {
     let l = (n.max(1) as f64).log2();
-    let ramp = |from: f64, to: f64| ((l - from) / (to - from)).clamp(0.0, 1.0);
-    0.625 + 0.25 * ramp(6.0, 8.0) + 0.075 * ramp(10.0, 12.0)
+    let (first, last) = (knots[0], knots[knots.len() - 1]);
+    if l <= first.0 {
+        return first.1;
+    }
+    if l >= last.0 {
+        return last.1;
+    }
+    let k = knots.partition_point(|&(x, _)| x <= l);
+    let ((x0, y0), (x1, y1)) = (knots[k - 1], knots[k]);
+    y0 + (y1 - y0) * (l - x0) / (x1 - x0)
 }
 
 /// Default cap of the draws a pixel expects.
@@ -349,13 +404,6 @@ pub fn default_exponent(n: usize) -> f64 {
 /// assert_eq!(tessera::lights::LightOptions::default().pixel_cap, tessera::lights::DEFAULT_PIXEL_CAP);
 /// ```
 pub const DEFAULT_PIXEL_CAP: f64 = 1.0;
-/// Default number of Lloyd steps.
-///
-/// # Example
-/// ```
-/// assert_eq!(tessera::lights::LightOptions::default().lloyd_steps, tessera::lights::DEFAULT_LLOYD_STEPS);
-/// ```
-pub const DEFAULT_LLOYD_STEPS: usize = 6;
 /// Default tolerance of the boundary split.
 ///
 /// # Example
@@ -370,7 +418,7 @@ impl Default for LightOptions<'_> {
             rgb: None,
             exponent: None,
             pixel_cap: DEFAULT_PIXEL_CAP,
-            lloyd_steps: DEFAULT_LLOYD_STEPS,
+            lloyd_steps: None,
             tolerance: DEFAULT_TOLERANCE,
             seed: None,
             table: None,
@@ -386,7 +434,7 @@ impl Default for LightOptions<'_> {
 /// use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, lights::*};
 /// let map = EnvMap::new(Raster { width: 64, height: 32, values: vec![1.0; 2048], bad_pixels: 0 }, Up::Z).unwrap();
 /// let (_, stats) = lights_with_stats(&map, 16, &LightOptions::default()).unwrap();
-/// assert_eq!(stats.passes, 1 + DEFAULT_LLOYD_STEPS);
+/// assert_eq!(stats.passes, 1 + default_lloyd_steps(16));
 /// // a constant map: mass and solid angle are the same fraction
 /// assert!((stats.unresolved_mass - stats.unresolved_area).abs() < 1e-9);
 /// assert!(stats.split_pixels > 0 && stats.pieces > 2048);
@@ -437,7 +485,7 @@ pub fn lights(map: &EnvMap, n: usize, options: &LightOptions) -> Result<Vec<Ligh
 /// use tessera::{lights::*, synth::Sky};
 /// let rgb = RgbMap::from(Sky::ClearSky.generate(256, 128, 1));
 /// let map = rgb.env_map(Default::default()).unwrap();
-/// let options = LightOptions { rgb: Some(&rgb), lloyd_steps: 1, ..Default::default() };
+/// let options = LightOptions { rgb: Some(&rgb), lloyd_steps: Some(1), ..Default::default() };
 /// let (l, stats) = lights_with_stats(&map, 256, &options).unwrap();
 /// assert_eq!((l.len(), stats.passes), (256, 2));
 /// // boundary pixels hold a part of the map; the rest went whole to a cell
@@ -463,10 +511,12 @@ pub fn lights_with_stats(
             options.pixel_cap
         )));
     }
-    if options.lloyd_steps > 100 {
+    let lloyd_steps = options
+        .lloyd_steps
+        .unwrap_or_else(|| default_lloyd_steps(n));
+    if lloyd_steps > 100 {
         return Err(Error::Request(format!(
-            "lights: {} Lloyd steps is more than 100",
-            options.lloyd_steps
+            "lights: {lloyd_steps} Lloyd steps is more than 100"
         )));
     }
     if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
@@ -549,13 +599,13 @@ pub fn lights_with_stats(
     loop {
         let gens = cells::Generators::new(generators.clone());
         // passes before the last only place generators: a coarser split
-        let coarse = if passes < options.lloyd_steps {
+        let coarse = if passes < lloyd_steps {
             1f64.max(options.tolerance) / options.tolerance
         } else {
             1.0
         };
         let cut = match (&place, &place_grid) {
-            (Some(p), Some(g)) if passes < options.lloyd_steps => {
+            (Some(p), Some(g)) if passes < lloyd_steps => {
                 let tol_place = options.tolerance * p.integral / n as f64;
                 cells::cells(g, &gens, tol_place * coarse, tol_area * coarse)
             }
@@ -568,7 +618,7 @@ pub fn lights_with_stats(
             .zip(&generators)
             .map(|(a, &g)| mean_direction(a).unwrap_or(g))
             .collect();
-        if passes > options.lloyd_steps {
+        if passes > lloyd_steps {
             let lights = cut
                 .acc
                 .iter()

@@ -35,12 +35,13 @@ pub(crate) struct LightsArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Density exponent: directions follow value^EXPONENT (default: a rule
-    /// of N, 0.625 at N <= 64, 0.875 at 256-1024, 0.95 from 4096).
+    /// of N, 0.2 at N <= 64 rising to 0.875 at 256-1024 and 0.95 from 4096).
     #[arg(long)]
     exponent: Option<f64>,
-    /// Lloyd steps after the first cut (each one more pass over the map).
-    #[arg(long, default_value_t = tessera::lights::DEFAULT_LLOYD_STEPS)]
-    lloyd: usize,
+    /// Lloyd steps after the first cut, each one more pass over the map
+    /// (default: a rule of N, 10 at N <= 128, 20 at 256-1024, 8 from 4096).
+    #[arg(long)]
+    lloyd: Option<usize>,
     /// Draw the directions with this sphere table (a `.lut` file `tessera
     /// lut build --system sphere` wrote) instead of the one built in: a
     /// rebuilt table without recompiling.
