@@ -40,7 +40,7 @@ fn to_lights(c: &mut Criterion) {
         b.iter(|| one.install(|| black_box(load(&path))))
     });
     let default_steps = tessera::lights::default_lloyd_steps(N);
-    for steps in [0, 3, 6, 8, 10] {
+    for steps in [0, 2, 3, 4, 5, 6, 8] {
         let label = if steps == default_steps {
             format!("tessera_lloyd_{steps}_default")
         } else {

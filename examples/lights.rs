@@ -633,7 +633,7 @@ fn bench_times(doc: &mut String) {
         "load_only".to_string(),
         "reading the EXR (colour and importance) only".to_string(),
     )];
-    for k in [0, 3, 6, 8, 10] {
+    for k in [0, 2, 3, 4, 5, 6, 8] {
         let (name, what) = if k == default_steps {
             (
                 format!("tessera_lloyd_{k}_default"),

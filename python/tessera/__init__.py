@@ -551,7 +551,7 @@ def lights(map, n, *, up="z", channel=None, strict=False, seed=None, exponent=No
         n <= 64 rising to 0.875 at 256-1024 and 0.95 from 4096).
     lloyd : int, optional
         Lloyd steps after the first cut (default: a rule of n, 10 at
-        n <= 128, 20 at 256-1024, 8 from 4096).
+        n <= 128, 20 at 256-1024, 4 from 4096).
 
     Examples
     --------

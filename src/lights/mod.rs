@@ -8,11 +8,12 @@
 //! directions' spherical Voronoi cells and gives each light its cell's
 //! power, the integral of each channel over the cell (map units x
 //! steradians), placed at the cell's luminance-weighted mean direction.
-//! Lloyd steps (8 to 20 by default, see [`default_lloyd_steps`]) first even the cells' shapes: each re-cuts
-//! the sphere around the cells' mean directions and re-centres, weighted
-//! by the square of the drawn density so that the steps keep the drawn
-//! spread (a Lloyd iteration weighted by the map itself would drift to
-//! `L^(1/2)`), on blocks of up to 8 x 8 pixels. The cells partition the
+//! Lloyd steps (4 to 20 by default, see [`default_lloyd_steps`]) first
+//! even the cells' shapes: each re-cuts the sphere around the cells' mean
+//! directions and re-centres, weighted by the square of the drawn density
+//! so that the steps keep the drawn spread (a Lloyd iteration weighted by
+//! the map itself would drift to `L^(1/2)`), on blocks of up to 8 x 8
+//! pixels. The cells partition the
 //! sphere, so the powers sum to the map's integral in every channel, to
 //! rounding.
 //!
@@ -276,7 +277,7 @@ pub struct LightOptions<'a> {
     /// cells' mean directions (weighted by the square of the drawn density)
     /// and re-centres, for one more pass over a grid of blocks of up to
     /// 8 x 8 pixels, at least 32 blocks per light (see [`LloydWeight`];
-    /// about 40 ms on one thread for a 1024 x 512 map at `n = 4096`,
+    /// about 50 ms on one thread for a 1024 x 512 map at `n = 4096`,
     /// docs/LIGHTS.md); at most 100. `None` takes
     /// [`default_lloyd_steps`] of the light count.
     pub lloyd_steps: Option<usize>,
@@ -357,17 +358,17 @@ pub const EXPONENT_KNOTS: [(f64, f64); 6] = [
 
 /// The Lloyd steps for `n` lights when none are given, piecewise linear
 /// in `log2 n` between [`LLOYD_KNOTS`] and rounded: a few hundred lights
-/// gain from 20 steps, while at 4096 lights and more the gain of a step
-/// no longer pays its cost (about 40 ms on one thread at 4096 lights on a
-/// 1024 x 512 map; docs/LIGHTS.md).
+/// gain from 20 steps, while at 4096 lights and more a step gains little
+/// and costs about 50 ms on one thread on a 1024 x 512 map: 4 steps keep
+/// that request under 0.5 s, reading the file included (docs/LIGHTS.md).
 ///
 /// # Example
 /// ```
 /// use tessera::lights::default_lloyd_steps;
 /// assert_eq!(default_lloyd_steps(64), 10);
 /// assert_eq!(default_lloyd_steps(512), 20);
-/// assert_eq!(default_lloyd_steps(2048), 14);
-/// assert_eq!(default_lloyd_steps(1 << 20), 8);
+/// assert_eq!(default_lloyd_steps(2048), 12);
+/// assert_eq!(default_lloyd_steps(1 << 20), 4);
 /// ```
 pub fn default_lloyd_steps(n: usize) -> usize {
     piecewise(&LLOYD_KNOTS, n).round() as usize
@@ -377,9 +378,9 @@ pub fn default_lloyd_steps(n: usize) -> usize {
 ///
 /// # Example
 /// ```
-/// assert_eq!(tessera::lights::LLOYD_KNOTS.last(), Some(&(12.0, 8.0)));
+/// assert_eq!(tessera::lights::LLOYD_KNOTS.last(), Some(&(12.0, 4.0)));
 /// ```
-pub const LLOYD_KNOTS: [(f64, f64); 4] = [(7.0, 10.0), (8.0, 20.0), (10.0, 20.0), (12.0, 8.0)];
+pub const LLOYD_KNOTS: [(f64, f64); 4] = [(7.0, 10.0), (8.0, 20.0), (10.0, 20.0), (12.0, 4.0)];
 
 /// Linear interpolation in `log2 n` between sorted knots, constant
 /// outside them.

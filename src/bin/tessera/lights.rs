@@ -39,7 +39,7 @@ pub(crate) struct LightsArgs {
     #[arg(long)]
     exponent: Option<f64>,
     /// Lloyd steps after the first cut, each one more pass over the map
-    /// (default: a rule of N, 10 at N <= 128, 20 at 256-1024, 8 from 4096).
+    /// (default: a rule of N, 10 at N <= 128, 20 at 256-1024, 4 from 4096).
     #[arg(long)]
     lloyd: Option<usize>,
     /// Draw the directions with this sphere table (a `.lut` file `tessera
