@@ -4,7 +4,7 @@
 //!
 //!     cargo run --release --example lights -- [--write] [--sweep] [--held-out]
 //!         [--quick] [--no-tables] [--exponent E] [--cap C] [--lloyd K]
-//!         [--tolerance T] [--configs E:C[:map],...] [--steps K,...] [--counts N,...]
+//!         [--tolerance T] [--configs E:C[:map],...] [--steps K|auto,...] [--counts N,...]
 //!         [--map-seed S] [--no-quadrature]
 //!
 //! For each map (clear sky, overcast, city at night, interior; 1024 x 512,
@@ -23,8 +23,9 @@
 //! error over seeded frames and the accuracy of the cells
 //! (`--no-quadrature` skips it); `--map-seed` generates the main maps from
 //! another seed (1 by default); `--held-out` repeats the summary on the
-//! maps of seeds 2-7 (4-7 held out from the choice of the defaults); `--write` writes docs/LIGHTS.md and docs/img/lights.png
-//! (`--write --sweep --held-out` is the full document); `--quick` runs only
+//! maps of seeds 2-7 (4-7 held out from the choice of the defaults);
+//! `--write` writes docs/LIGHTS.md and docs/img/lights.png (`--write
+//! --sweep --held-out` is the full document); `--quick` runs only
 //! the unrotated maps; `--exponent`, `--cap`, `--lloyd`, `--tolerance`
 //! override tessera's defaults in the tables.
 
@@ -426,28 +427,24 @@ fn main() {
     if args.held_out {
         for seed in HELD_OUT {
             let held = build_cases(seed, &frames, &probes);
+            let (heading, summary, why) = if TUNED_ON.contains(&seed) {
+                ("Checked", "Check", "The per-N exponent and Lloyd steps were chosen on the maps of seeds 1-3, so this seed is not held out.")
+            } else {
+                (
+                    "Held out",
+                    "Held-out",
+                    "No default was chosen on this seed: a held-out check.",
+                )
+            };
             let _ = writeln!(
                 doc,
-                "\n# {}: the same maps generated from seed {seed}\n\nThe same comparison on the maps of seed {seed} (another sun position, other lights, lamps and texture), in the same frames. {}\n",
-                if TUNED_ON.contains(&seed) { "Checked" } else { "Held out" },
-                if TUNED_ON.contains(&seed) {
-                    "The per-N exponent and Lloyd steps were chosen on the maps of seeds 1-3, so this seed is not held out."
-                } else {
-                    "No default was chosen on this seed: a held-out check."
-                }
+                "\n# {heading}: the same maps generated from seed {seed}\n\nThe same comparison on the maps of seed {seed} (another sun position, other lights, lamps and texture), in the same frames. {why}\n"
             );
             tables(
                 &held,
                 &probes,
                 &args.options,
-                &format!(
-                    "{} summary, seed {seed}",
-                    if TUNED_ON.contains(&seed) {
-                        "Check"
-                    } else {
-                        "Held-out"
-                    }
-                ),
+                &format!("{summary} summary, seed {seed}"),
                 false,
                 &mut doc,
             );

@@ -13,9 +13,8 @@
 //! directions and re-centres, weighted by the square of the drawn density
 //! so that the steps keep the drawn spread (a Lloyd iteration weighted by
 //! the map itself would drift to `L^(1/2)`), on blocks of up to 8 x 8
-//! pixels. The cells partition the
-//! sphere, so the powers sum to the map's integral in every channel, to
-//! rounding.
+//! pixels. The cells partition the sphere, so the powers sum to the map's
+//! integral in every channel, to rounding.
 //!
 //! Cells are integrated over the per-pixel model (the map constant per
 //! pixel per steradian). A pixel that a distance bound proves to lie in
