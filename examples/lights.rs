@@ -957,7 +957,7 @@ fn around(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
     // 1024 fixed normals (the RMS over 64 is dominated by a few)
     let _ = writeln!(
         doc,
-        "\nAt N = 4096, tessera's diffuse error over the better median cut's three ways: over the fixed 64 normals (the floors' measure); over the same normals turned along with each frame's rotation, so every frame sees the content from the same directions and only the pixel grid and the tiling's orientation differ; and over 1024 fixed normals (`uniform_random_sphere(1024, 1)`): on the city a few of 64 normals whose horizons graze bright lamps carry most of the RMS.\n\n| map / frame | 64 normals | 64 normals, turned | 1024 normals |\n|---|---:|---:|---:|"
+        "\nAt N = 4096, tessera's diffuse error over the better median cut's three ways: over the fixed 64 normals (the floors' measure); over the same normals turned along with each frame's rotation, so every frame sees the content from the same directions and only the pixel grid and the tiling's orientation differ; and over 1024 fixed normals (`uniform_random_sphere(1024, 1)`): an RMS over 64 normals can be carried by a few of them, and 1024 show the trend.\n\n| map / frame | 64 normals | 64 normals, turned | 1024 normals |\n|---|---:|---:|---:|"
     );
     let many = Probes {
         normals: uniform_random_sphere(1024, 1),
