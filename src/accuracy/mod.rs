@@ -20,6 +20,7 @@
 //! ```
 
 mod integrands;
+mod lights;
 mod report;
 mod scenarios;
 
@@ -116,7 +117,8 @@ pub struct Row {
     pub n: usize,
     /// Mean number of points actually drawn (some methods only come close).
     pub count: f64,
-    /// Relative RMSE over the seeds.
+    /// Relative RMSE over the seeds (the `sphere-lights` rows: over the
+    /// lobe's normals or axes, the sets being deterministic).
     pub rel_rmse: f64,
     /// Median seconds to draw one set, one thread.
     pub seconds: f64,
@@ -172,7 +174,8 @@ struct Scenario<'a, P> {
     methods: Vec<Method<'a, P>>,
 }
 
-/// Runs every scenario (sphere uniform, sphere env map, plane uniform).
+/// Runs every scenario (sphere uniform, sphere env map, plane uniform, and
+/// the env map as lights against median cut).
 /// Drawing runs on a one-thread pool (times comparable across samplers);
 /// estimates are evaluated in parallel.
 ///
@@ -183,6 +186,7 @@ struct Scenario<'a, P> {
 /// let stratified = |r: &&tessera::accuracy::Row| r.method == "stratified inverse-CDF";
 /// assert!(results.rows.iter().filter(stratified).all(|r| r.scenario == "sphere-envmap"));
 /// assert!(results.rows.iter().filter(stratified).any(|r| r.rel_rmse > 0.0));
+/// assert!(results.rows.iter().any(|r| r.scenario == "sphere-lights" && r.method == "median cut (greedy)"));
 /// ```
 pub fn run(config: &Config) -> Results {
     let start = Instant::now();
@@ -197,6 +201,7 @@ pub fn run(config: &Config) -> Results {
     let mut rows = measure(&scenarios::sphere_uniform(), config, &pool);
     rows.extend(measure(&scenarios::sphere_envmap(&sky), config, &pool));
     rows.extend(measure(&scenarios::plane_uniform(), config, &pool));
+    rows.extend(lights::rows(&sky, config, &pool));
     Results {
         config: config.clone(),
         rows,

@@ -30,12 +30,27 @@ use rayon::prelude::*;
 /// assert!((exact(&map, &[glam::DVec3::X])[0] - 2.0 * std::f64::consts::PI).abs() < 1e-3);
 /// ```
 pub fn exact(map: &EnvMap, normals: &[DVec3]) -> Vec<f64> {
+    exact_lobe(map, normals, |c| c.max(0.0))
+}
+
+/// Reference integral `integral of L(w) lobe(a . w) dw` for each axis `a`,
+/// by [`exact`]'s quadrature: a Phong lobe is `max(0, c)^m`.
+///
+/// # Example
+/// ```
+/// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, metrics::irradiance::exact_lobe};
+/// let map = EnvMap::new(Raster { width: 8, height: 4, values: vec![1.0; 32], bad_pixels: 0 }, Up::Z).unwrap();
+/// // a constant unit sky: the Phong lobe of exponent 10 integrates to 2 pi / 11
+/// let g = exact_lobe(&map, &[glam::DVec3::Z], |c| c.max(0.0).powi(10));
+/// assert!((g[0] - std::f64::consts::TAU / 11.0).abs() < 1e-2);
+/// ```
+pub fn exact_lobe(map: &EnvMap, axes: &[DVec3], lobe: impl Fn(f64) -> f64 + Sync) -> Vec<f64> {
     let (w, h) = (map.width(), map.height());
     // row by row: each row's sub-pixel nodes against every normal
     (0..h)
         .into_par_iter()
         .map(|j| {
-            let mut sums = vec![0.0; normals.len()];
+            let mut sums = vec![0.0; axes.len()];
             for i in 0..w {
                 let v = map.values()[j * w + i];
                 if v <= 0.0 {
@@ -50,15 +65,15 @@ pub fn exact(map: &EnvMap, normals: &[DVec3]) -> Vec<f64> {
                         ((s / k) as f64 + 0.5) / k as f64,
                     );
                     let d = map.direction_in_pixel(i, j, u, t);
-                    for (sum, n) in sums.iter_mut().zip(normals) {
-                        *sum += weight * n.dot(d).max(0.0);
+                    for (sum, n) in sums.iter_mut().zip(axes) {
+                        *sum += weight * lobe(n.dot(d));
                     }
                 }
             }
             sums
         })
         .reduce(
-            || vec![0.0; normals.len()],
+            || vec![0.0; axes.len()],
             |mut a, b| {
                 a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
                 a
