@@ -252,6 +252,17 @@ fn errors(lights: &[Light], probes: &Probes, reference: &Reference) -> [f64; 3] 
 
 /// Errors of tessera, classic and greedy median cut at one N: `[method][metric]`.
 fn compare(case: &Case, n: usize, options: &LightOptions, probes: &Probes) -> [[f64; 3]; 3] {
+    compare_against(case, &case.reference, n, options, probes)
+}
+
+/// [`compare`] against another reference (of other probes).
+fn compare_against(
+    case: &Case,
+    reference: &Reference,
+    n: usize,
+    options: &LightOptions,
+    probes: &Probes,
+) -> [[f64; 3]; 3] {
     let options = LightOptions {
         rgb: Some(&case.rgb),
         ..*options
@@ -259,7 +270,7 @@ fn compare(case: &Case, n: usize, options: &LightOptions, probes: &Probes) -> [[
     let ours = lights(&case.map, n, &options).expect("lights");
     let classic = median_cut(&case.map, Some(&case.rgb), n, MedianCut::Classic).expect("cut");
     let greedy = median_cut(&case.map, Some(&case.rgb), n, MedianCut::Greedy).expect("cut");
-    [ours, classic, greedy].map(|l| errors(&l, probes, &case.reference))
+    [ours, classic, greedy].map(|l| errors(&l, probes, reference))
 }
 
 struct Args {
@@ -350,6 +361,24 @@ fn args() -> Args {
         }
     }
     a
+}
+
+/// A markdown table's head: the fixed columns, then one per count with
+/// its label and alignment rule.
+fn table_head(
+    first: &str,
+    first_rule: &str,
+    counts: &[usize],
+    label: impl Fn(usize) -> String,
+    cell_rule: &str,
+) -> (String, String) {
+    let mut header = String::from(first);
+    let mut rule = String::from(first_rule);
+    for &n in counts {
+        let _ = write!(header, " {} |", label(n));
+        rule.push_str(cell_rule);
+    }
+    (header, rule)
 }
 
 fn ratio_cell(r: f64) -> String {
@@ -542,12 +571,13 @@ fn tables(
         steps_label(options.lloyd_steps),
         options.tolerance
     );
-    let mut header = String::from("| map / frame |");
-    let mut rule = String::from("|---|");
-    for n in COUNTS {
-        let _ = write!(header, " N = {n} |");
-        rule.push_str("---|");
-    }
+    let (header, rule) = table_head(
+        "| map / frame |",
+        "|---|",
+        &COUNTS,
+        |n| format!("N = {n}"),
+        "---|",
+    );
     let _ = writeln!(doc, "{header}\n{rule}");
     let mut misses = Vec::new();
     let mut all_ratios = [vec![], vec![], vec![]];
@@ -824,12 +854,13 @@ fn sweep(cases: &[Case], probes: &Probes, args: &Args, doc: &mut String) {
         doc,
         "\nThe same geometric means per N (diffuse / glossy 10 / glossy 100):\n"
     );
-    let mut header = String::from("| exponent | pixel cap | Lloyd weight | Lloyd steps |");
-    let mut rule = String::from("|---:|---:|---|---:|");
-    for n in &counts {
-        let _ = write!(header, " N = {n} |");
-        rule.push_str("---|");
-    }
+    let (header, rule) = table_head(
+        "| exponent | pixel cap | Lloyd weight | Lloyd steps |",
+        "|---:|---:|---|---:|",
+        &counts,
+        |n| format!("N = {n}"),
+        "---|",
+    );
     let _ = writeln!(doc, "{header}\n{rule}");
     for (e, cap, wname, k, by_n) in per_n {
         let mut row = format!("| {e} | {cap} | {wname} | {k} |");
@@ -917,12 +948,13 @@ fn around(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
         doc,
         "\n## Diffuse error across N (seed-{seed} maps)\n\nThe maps of seed {seed} (the held-out seed with the most misses) at nine counts a quarter octave apart: tessera's diffuse error over the better median cut's, then the geometric mean over the counts and how many exceed 1. A floor is checked at one N; median cut's error jumps between neighbouring counts (a region split or not moves its light across the normals' horizons), while tessera's falls smoothly, so a miss at one N can be median cut's luck there.\n"
     );
-    let mut header = String::from("| map / frame |");
-    let mut rule = String::from("|---|");
-    for n in &counts {
-        let _ = write!(header, " {n} |");
-        rule.push_str("---:|");
-    }
+    let (header, rule) = table_head(
+        "| map / frame |",
+        "|---|",
+        &counts,
+        |n| n.to_string(),
+        "---:|",
+    );
     let _ = writeln!(doc, "{header} geo. mean | above 1 |\n{rule}---:|---:|");
     let mut worst: Option<(f64, String, Vec<[f64; 3]>)> = None;
     for case in cases {
@@ -972,30 +1004,17 @@ fn around(cases: &[Case], probes: &Probes, options: &LightOptions, doc: &mut Str
             normals: probes.normals.iter().map(|&n| rotation * n).collect(),
             axes: probes.axes.clone(),
         };
-        let ratio = |probes: &Probes, reference: Option<Reference>| {
-            let owned;
-            let case = match reference {
-                Some(reference) => {
-                    owned = Case {
-                        reference,
-                        rgb: case.rgb.clone(),
-                        map: case.map.clone(),
-                        ..*case
-                    };
-                    &owned
-                }
-                None => case,
-            };
-            let e = compare(case, 4096, options, probes).map(|m| m[0]);
+        let ratio = |probes: &Probes, reference: &Reference| {
+            let e = compare_against(case, reference, 4096, options, probes).map(|m| m[0]);
             ratio_cell(e[0] / e[1].min(e[2]))
         };
         let _ = writeln!(
             doc,
             "| {} | {} | {} | {} |",
             case.label(),
-            ratio(probes, None),
-            ratio(&turned, Some(reference(&case.map, &turned))),
-            ratio(&many, Some(reference(&case.map, &many)))
+            ratio(probes, &case.reference),
+            ratio(&turned, &reference(&case.map, &turned)),
+            ratio(&many, &reference(&case.map, &many))
         );
     }
     let _ = writeln!(doc);
