@@ -93,21 +93,33 @@ pub struct SphereLut {
 }
 
 impl SphereLut {
-    /// The importance bin of a density fraction `f` in `(0, 1]` of a level's
-    /// capacity: the first bin optimised for `f` or more, so the tiles
-    /// accepted at `f` are a subset of those the bin was optimised with
-    /// (holes at worst, never a crowd).
+    /// The importance bin of a density fraction `f` in `(0, 1]` of a level
+    /// of `capacity` tiles: the first bin whose relaxed set holds every
+    /// tile the engine accepts at `f` (codes `c + 1/2 < f * capacity`). So
+    /// the accepted tiles are a subset of the bin's (holes at worst, never
+    /// a crowd), and a request keeping exactly a bin's tiles gets the
+    /// offsets they were relaxed with, even when its fraction lies a
+    /// sliver above the bin's.
     ///
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// assert_eq!(lut.bin(1.0), lut.bin_fractions.len() - 1);
-    /// assert_eq!(lut.bin(0.25), 0);
-    /// assert_eq!(lut.bin(1e-9), 0);
-    /// assert_eq!(lut.bin_fractions[lut.bin(0.8)], 0.8);
+    /// let capacity = 3840.0; // level 2
+    /// assert_eq!(lut.bin(1.0, capacity), lut.bin_fractions.len() - 1);
+    /// assert_eq!(lut.bin(0.25, capacity), 0);
+    /// assert_eq!(lut.bin(1e-9, capacity), 0);
+    /// assert_eq!(lut.bin_fractions[lut.bin(0.8, capacity)], 0.8);
+    /// // a bin relaxed on the codes below 1235.4 serves 1236 samples
+    /// let b = lut.bin(1236.0 / capacity, capacity);
+    /// assert!(lut.bin_fractions[b] < 1236.0 / capacity);
     /// ```
-    pub fn bin(&self, fraction: f64) -> usize {
-        bin_in(&self.bin_fractions, fraction)
+    pub fn bin(&self, fraction: f64, capacity: f64) -> usize {
+        let accepted = (fraction * capacity - 0.5).ceil();
+        // the optimiser relaxed bin `b` on the codes below `edge_b * capacity`
+        self.bin_fractions
+            .iter()
+            .position(|&edge| accepted <= (edge * capacity).ceil())
+            .unwrap_or(self.bins() - 1)
     }
 
     /// Number of importance bins.
@@ -266,12 +278,6 @@ fn dequantise(stored: [i8; 2]) -> [f64; 2] {
 
 /// The first bin whose optimised fraction is at or above `fraction` (with a
 /// relative tolerance for rounding), given those fractions in increasing order.
-pub(crate) fn bin_in(edges: &[f64], fraction: f64) -> usize {
-    edges
-        .iter()
-        .position(|&edge| fraction <= edge * (1.0 + 1e-9))
-        .unwrap_or(edges.len() - 1)
-}
 
 /// The density fractions of `count` importance bins: equally spaced in
 /// `log4 f` from 1/4 to 1, with the grid point nearest each of

@@ -213,8 +213,34 @@ fn common_counts_use_a_bin_optimised_for_exactly_their_density() {
         if fraction <= 0.25 {
             continue; // the level below is full: no holes either
         }
-        let bin = lut.bin(fraction);
+        let bin = lut.bin(fraction, tiling.capacity(level));
         assert_relative_eq!(lut.bin_fractions[bin], fraction, max_relative = 1e-12);
+    }
+}
+
+#[test]
+fn every_bins_own_count_gets_the_set_it_was_relaxed_on() {
+    // the optimiser relaxed bin b on the codes below `f_b * capacity`; most
+    // bins' fractions are not multiples of 1 / capacity, so that count lies
+    // a sliver above f_b and must still use bin b (it used b + 1, leaving
+    // one hole and a covering of 3.5-3.8 at half the bins)
+    use tessera::metrics::sphere::covering_radius;
+    let tiling = SphereTiling::default();
+    let capacity = tiling.capacity(2);
+    for &edge in &tiling.lut().bin_fractions[1..] {
+        let n = (edge * capacity).ceil() as usize;
+        let points: Vec<DVec3> = Sampler::sphere()
+            .count(n)
+            .generate()
+            .unwrap()
+            .iter()
+            .map(|s| s.position)
+            .collect();
+        let covering = covering_radius(&points);
+        assert!(
+            covering <= 3.0,
+            "N = {n} (bin {edge:.4}): covering {covering:.2}"
+        );
     }
 }
 

@@ -330,7 +330,8 @@ impl SphereTiling {
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        lut.offset(tile.level as usize, tile.index as usize, lut.bin(fraction))
+        let bin = lut.bin(fraction, self.capacity(tile.level as u32));
+        lut.offset(tile.level as usize, tile.index as usize, bin)
     }
 
     /// The shape of every tile.
