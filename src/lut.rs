@@ -276,9 +276,6 @@ fn dequantise(stored: [i8; 2]) -> [f64; 2] {
     [0, 1].map(|k| stored[k] as f64 / OFFSET_SCALE + OFFSET_CENTRE[k])
 }
 
-/// The first bin whose optimised fraction is at or above `fraction` (with a
-/// relative tolerance for rounding), given those fractions in increasing order.
-
 /// The density fractions of `count` importance bins: equally spaced in
 /// `log4 f` from 1/4 to 1, with the grid point nearest each of
 /// [`COMMON_FRACTIONS`] moved onto it (`count >= 6`, so that each has an
