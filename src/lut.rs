@@ -33,7 +33,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 3;
+pub const SPHERE_LUT_VERSION: u32 = 4;
 
 /// Offsets are stored as `i8` multiples of `1 / OFFSET_SCALE` cells from
 /// [`OFFSET_CENTRE`] (resolution 0.025 cells, 0.3 % of the point spacing;
@@ -90,7 +90,18 @@ pub struct SphereLut {
     /// `index * bins + bin`, in the tile's frame, as cells from
     /// [`OFFSET_CENTRE`] times [`OFFSET_SCALE`].
     pub tables: Vec<Vec<[i8; 2]>>,
+    /// Sibling-fill offsets of the per-tile levels (none at level 0),
+    /// indexed `parent index * FILL_PAIRS + pair` (see
+    /// [`SphereLut::fill_pair`]): a request between two bins keeps a prefix
+    /// of the upper bin's set, and where that drops one child of a parent,
+    /// its lower siblings take these offsets, relaxed with it missing and
+    /// every other point of the bin in place.
+    pub fills: Vec<Vec<[i8; 2]>>,
 }
+
+/// Sibling-fill entries per parent: a kept child `s` below a missing
+/// child `d` (`s < d <= 3`), `d (d - 1) / 2 + s`.
+pub const FILL_PAIRS: usize = 6;
 
 impl SphereLut {
     /// The importance bin of a density fraction `f` in `(0, 1]` of a level
@@ -114,7 +125,7 @@ impl SphereLut {
     /// assert!(lut.bin_fractions[b] < 1236.0 / capacity);
     /// ```
     pub fn bin(&self, fraction: f64, capacity: f64) -> usize {
-        let accepted = (fraction * capacity - 0.5).ceil();
+        let accepted = accepted_count(fraction, capacity);
         // the optimiser relaxed bin `b` on the codes below `edge_b * capacity`
         self.bin_fractions
             .iter()
@@ -176,6 +187,62 @@ impl SphereLut {
     pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
         let table = &self.tables[level.min(self.tables.len() - 1)];
         dequantise(table[index * self.bins() + bin])
+    }
+
+    /// Which sibling-fill entry a tile of a per-tile level takes at density
+    /// `fraction` of its level (capacity `capacity`, importance bin `bin`):
+    /// `Some(pair)` when the bin's set has a sibling of higher digit that
+    /// the request drops. `code` is the tile's code: its parent's code
+    /// plus its digit times the parent level's capacity.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// let capacity = 3840.0; // level 2; 960 parents
+    /// let fraction = 1300.0 / capacity;
+    /// let bin = lut.bin(fraction, capacity);
+    /// // bin 3 keeps codes below 1401.1, so the parent of code 1350
+    /// // (code 1350 - 960 = 390) lacks its digit-1 child; its digit-0
+    /// // child, code 390, fills in
+    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity), Some(0));
+    /// // the parent of code 291 keeps both children the bin has
+    /// assert_eq!(lut.fill_pair(291, 2, fraction, bin, capacity), None);
+    /// ```
+    pub fn fill_pair(
+        &self,
+        code: u128,
+        level: u32,
+        fraction: f64,
+        bin: usize,
+        capacity: f64,
+    ) -> Option<usize> {
+        if level == 0 || level >= self.exact_levels as u32 {
+            return None;
+        }
+        let accepted = accepted_count(fraction, capacity);
+        // the bin's set: codes below `f_b * capacity` (see `bin`)
+        let in_bin = (self.bin_fractions[bin] * capacity).ceil();
+        let parents = capacity / 4.0;
+        let code = code as f64;
+        let (parent, digit) = (code % parents, (code / parents).floor());
+        // the lowest sibling the request drops, if the bin keeps it
+        let missing = ((accepted - parent) / parents).ceil().max(digit + 1.0);
+        let missing_code = parent + missing * parents;
+        (missing <= 3.0 && missing_code < in_bin && code < accepted)
+            .then(|| (missing * (missing - 1.0) / 2.0 + digit) as usize)
+    }
+
+    /// The sibling-fill offset (tile frame, cells) of entry `pair` of the
+    /// parent of tree index `parent` at per-tile level `level`.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// let o = lut.fill(2, 0, 0);
+    /// assert!((-1.0..=3.0).contains(&o[0]) && (-1.0..=4.0).contains(&o[1]));
+    /// ```
+    pub fn fill(&self, level: usize, parent: usize, pair: usize) -> [f64; 2] {
+        dequantise(self.fills[level][parent * FILL_PAIRS + pair])
     }
 
     /// Quantises an offset (cells, tile frame) for storage.
@@ -247,6 +314,11 @@ impl SphereLut {
         if self.tables.len() <= self.exact_levels as usize {
             return bad("need one table per exact level and at least one class table");
         }
+        // offsets stay within one cell of the pentomino's 2x3 box
+        let inside = |stored: [i8; 2]| {
+            let [x, y] = dequantise(stored);
+            (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
+        };
         for (level, table) in self.tables.iter().enumerate() {
             let rows = if level < self.exact_levels as usize {
                 roots << (2 * level)
@@ -256,14 +328,27 @@ impl SphereLut {
             if table.len() != rows * self.bins() {
                 return bad(&format!("offset table {level} has the wrong size"));
             }
-            // offsets stay within one cell of the pentomino's 2x3 box
-            let inside = |stored: [i8; 2]| {
-                let [x, y] = dequantise(stored);
-                (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
-            };
             if let Some(at) = table.iter().position(|&o| !inside(o)) {
                 return bad(&format!(
                     "offset table {level} entry {at} lies outside the tile's neighbourhood"
+                ));
+            }
+        }
+        if self.fills.len() != self.exact_levels as usize {
+            return bad("need one sibling-fill table per exact level");
+        }
+        for (level, fills) in self.fills.iter().enumerate() {
+            let parents = if level == 0 {
+                0
+            } else {
+                roots << (2 * (level - 1))
+            };
+            if fills.len() != parents * FILL_PAIRS {
+                return bad(&format!("sibling-fill table {level} has the wrong size"));
+            }
+            if fills.iter().any(|&o| !inside(o)) {
+                return bad(&format!(
+                    "sibling-fill table {level} has an offset outside the tile's neighbourhood"
                 ));
             }
         }
@@ -271,8 +356,14 @@ impl SphereLut {
     }
 }
 
+/// How many tiles of a level of `capacity` the engine keeps at density
+/// `fraction`: codes `c + 1/2 < fraction * capacity`.
+fn accepted_count(fraction: f64, capacity: f64) -> f64 {
+    (fraction * capacity - 0.5).ceil()
+}
+
 /// A stored offset in cells, tile frame.
-fn dequantise(stored: [i8; 2]) -> [f64; 2] {
+pub(crate) fn dequantise(stored: [i8; 2]) -> [f64; 2] {
     [0, 1].map(|k| stored[k] as f64 / OFFSET_SCALE + OFFSET_CENTRE[k])
 }
 

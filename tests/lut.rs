@@ -24,4 +24,10 @@ fn bad_tables_are_refused_with_a_reason() {
     let mut far = (*sphere_lut()).clone();
     far.tables[0][0] = [i8::MAX, 0];
     assert!(err(&far.to_bytes()).contains("outside"));
+    let mut short = (*sphere_lut()).clone();
+    short.fills[2].pop();
+    assert!(err(&short.to_bytes()).contains("sibling-fill table 2 has the wrong size"));
+    let mut far_fill = (*sphere_lut()).clone();
+    far_fill.fills[1][0] = [0, i8::MIN];
+    assert!(err(&far_fill.to_bytes()).contains("sibling-fill table 1 has an offset outside"));
 }

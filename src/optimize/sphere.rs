@@ -17,7 +17,7 @@
 
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
-use crate::lut::{SphereLut, SPHERE_LUT_VERSION};
+use crate::lut::{SphereLut, FILL_PAIRS, SPHERE_LUT_VERSION};
 use crate::polyomino::exact_cover;
 use crate::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
 use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
@@ -184,6 +184,7 @@ pub fn build(
         transitions: Vec::new(),
         bin_fractions: crate::lut::bin_fractions(options.bins as usize),
         tables: Vec::new(),
+        fills: Vec::new(),
     };
     lut.root_rank = root_ranks(&lut);
     let enumerator = SphereTiling::new(Arc::new(lut.clone()));
@@ -214,6 +215,9 @@ pub fn build(
         &mut report,
     );
     lap(&mut report, "lloyd");
+
+    lut.fills = sibling_fills(&enumerator, &lut, progress);
+    lap(&mut report, "sibling fills");
     Ok((lut, report))
 }
 
@@ -989,12 +993,8 @@ fn relax_bin(
                     .to_vec()
             })
             .collect();
-        // the tiling's symmetries give many sites equal coordinates, which
-        // degrades the k-d tree badly; a fixed generic rotation (distances
-        // unchanged) breaks the ties
-        let skew = glam::DQuat::from_euler(glam::EulerRot::ZXY, 0.3141, 0.2718, 0.1618);
-        let points: Vec<[f64; 3]> = sites.iter().map(|&v| (skew * v).to_array()).collect();
-        let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(&points);
+        let tree = site_tree(&sites);
+        let skew = skew();
         // deterministic: each block of rows sums in order, blocks merge in order
         let blocks: Vec<HashMap<u32, DVec3>> = (0..12 * qside)
             .into_par_iter()
@@ -1085,6 +1085,178 @@ fn relax_bin(
         .map(|(o, p)| if p { o } else { None })
         .collect();
     (offsets, residual)
+}
+
+/// Closest a sibling-fill point may come to any other point a request using
+/// its bin may keep, in point spacings of the bin's set: below the
+/// separation floor of 2.4 / sqrt(N) and the bin's own 2.6-3.0.
+const FILL_GUARD: f64 = 0.75;
+
+/// The sibling fills of one bin that keep every pair of points a request
+/// may hold at least [`FILL_GUARD`] spacings apart: each problem (the
+/// siblings of one missing code, `below + 1 + k` for `problems[k]`)
+/// whole or not at all, in code order, against the bin's points (its own
+/// missing child and siblings aside) and the fills already kept.
+fn guard_separation(
+    problems: &[Vec<Fill>],
+    sites: &[DVec3],
+    below: usize,
+    parents: usize,
+    spacing: f64,
+) -> Vec<(usize, [i8; 2])> {
+    let guard = FILL_GUARD * spacing;
+    let tree = site_tree(sites);
+    let mut kept: Vec<(usize, DVec3)> = Vec::new();
+    let mut entries = Vec::new();
+    for (k, problem) in problems.iter().enumerate() {
+        let missing = below + 1 + k;
+        let family = |c: usize| c % parents == missing % parents;
+        let clear = problem.iter().all(|fill| {
+            let p = fill.placed;
+            let near =
+                tree.within_unsorted::<SquaredEuclidean>(&(skew() * p).to_array(), guard * guard);
+            near.iter().all(|n| family(n.item as usize))
+                && kept
+                    .iter()
+                    .all(|&(c, q)| family(c) || p.distance(q) >= guard)
+        }) && problem.iter().enumerate().all(|(i, a)| {
+            problem[i + 1..]
+                .iter()
+                .all(|b| a.placed.distance(b.placed) >= guard)
+        });
+        if clear {
+            kept.extend(problem.iter().map(|fill| (missing, fill.placed)));
+        }
+        // a problem left out keeps its siblings where the bin has them
+        entries.extend(
+            problem
+                .iter()
+                .map(|fill| (fill.row, if clear { fill.stored } else { fill.unmoved })),
+        );
+    }
+    entries
+}
+
+/// One sibling's fill: its row in the fill table, the stored offset, the
+/// point it gives, and the bin's own offset for the tile.
+struct Fill {
+    row: usize,
+    stored: [i8; 2],
+    placed: DVec3,
+    unmoved: [i8; 2],
+}
+
+/// A fixed generic rotation: the tiling's symmetries give many sites equal
+/// coordinates, which degrades a k-d tree badly, and rotating every point
+/// (distances unchanged) breaks the ties.
+fn skew() -> glam::DQuat {
+    glam::DQuat::from_euler(glam::EulerRot::ZXY, 0.3141, 0.2718, 0.1618)
+}
+
+/// A k-d tree of `sites` rotated by [`skew`].
+fn site_tree(sites: &[DVec3]) -> ImmutableKdTree<f64, u32, 3, 32> {
+    let skew = skew();
+    let points: Vec<[f64; 3]> = sites.iter().map(|&v| (skew * v).to_array()).collect();
+    ImmutableKdTree::new_from_slice(&points)
+}
+
+/// Lloyd iterations of each sibling-fill problem.
+const FILL_ITERATIONS: usize = 10;
+/// Radius, in point spacings, of the neighbourhood a sibling-fill problem
+/// relaxes in.
+const FILL_RADIUS: f64 = 3.5;
+
+/// The sibling-fill tables (see [`SphereLut::fills`]). For each bin of a
+/// per-tile level and each code of the bin's set that a request using the
+/// bin may drop, the dropped tile's lower siblings are relaxed with it
+/// missing and every other point of the bin's set held in place. Each
+/// parent alone: in a request, the parents around it may keep all their
+/// children, and siblings relaxed together with a neighbour's hole would
+/// crowd that neighbour's child when it is kept.
+fn sibling_fills(tiling: &SphereTiling, lut: &SphereLut, progress: Progress) -> Vec<Vec<[i8; 2]>> {
+    let exact = lut.exact_levels as u32;
+    let room = tiling.shape().dilated();
+    let unused = SphereLut::quantise(tiling.shape().centroid());
+    let mut fills = vec![Vec::new()];
+    for level in 1..exact {
+        let capacity = tiling.capacity(level);
+        let parents = capacity as usize / 4;
+        let mut by_code = tiling.tiles(level);
+        by_code.sort_unstable_by_key(|t| t.code);
+        let mut table = vec![unused; parents * FILL_PAIRS];
+        for bin in 1..lut.bins() {
+            let in_bin = (lut.bin_fractions[bin] * capacity).ceil() as usize;
+            let below = (lut.bin_fractions[bin - 1] * capacity).ceil() as usize;
+            let offset = |c: usize| lut.offset(level as usize, by_code[c].index as usize, bin);
+            let sites: Vec<DVec3> = (0..in_bin)
+                .map(|c| tiling.face_point(&by_code[c], offset(c)).to_vec())
+                .collect();
+            let tree = site_tree(&sites);
+            let spacing = (4.0 * std::f64::consts::PI / in_bin as f64).sqrt();
+            let radius2 = (FILL_RADIUS * spacing).powi(2);
+            // each missing code's problem: its siblings' rows, stored
+            // offsets and the points those offsets give
+            let problems: Vec<Vec<Fill>> = (below + 1..in_bin)
+                .into_par_iter()
+                .map(|missing| {
+                    let (digit, parent) = (missing / parents, missing % parents);
+                    let siblings: Vec<usize> = (0..digit).map(|j| parent + j * parents).collect();
+                    let near = tree.within_unsorted::<SquaredEuclidean>(
+                        &(skew() * sites[missing]).to_array(),
+                        radius2,
+                    );
+                    let local: Vec<usize> = near
+                        .iter()
+                        .map(|n| n.item as usize)
+                        .filter(|&c| c != missing)
+                        .collect();
+                    let mut points: Vec<DVec3> = local.iter().map(|&c| sites[c]).collect();
+                    for _ in 0..FILL_ITERATIONS {
+                        let before = points.clone();
+                        crate::relax::relax(&mut points, &crate::density::Uniform, 1)
+                            .expect("sites are unit vectors");
+                        for (k, &c) in local.iter().enumerate() {
+                            if !siblings.contains(&c) {
+                                points[k] = before[k];
+                            }
+                        }
+                    }
+                    local
+                        .iter()
+                        .zip(points)
+                        .filter(|(c, _)| siblings.contains(c))
+                        .map(|(&c, target)| {
+                            let tile = &by_code[c];
+                            let mut current = offset(c);
+                            for _ in 0..3 {
+                                let site = tiling.face_point(tile, current).to_vec();
+                                current = to_local(tiling, tile, current, site, target);
+                            }
+                            let stored = SphereLut::quantise(room.clamp(current, 0.02));
+                            let pair = digit * (digit - 1) / 2 + c / parents;
+                            let row = tile.index as usize / 4 * FILL_PAIRS + pair;
+                            let placed = tiling.face_point(tile, crate::lut::dequantise(stored));
+                            let unmoved =
+                                lut.tables[level as usize][tile.index as usize * lut.bins() + bin];
+                            Fill {
+                                row,
+                                stored,
+                                placed: placed.to_vec(),
+                                unmoved,
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let entries = guard_separation(&problems, &sites, below, parents, spacing);
+            for (row, o) in entries {
+                table[row] = o;
+            }
+        }
+        progress("sibling fills", level as u64, exact as u64 - 1);
+        fills.push(table);
+    }
+    fills
 }
 
 /// The tile-frame point whose image is (to first order) `target`, from the

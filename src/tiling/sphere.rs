@@ -330,8 +330,13 @@ impl SphereTiling {
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        let bin = lut.bin(fraction, self.capacity(tile.level as u32));
-        lut.offset(tile.level as usize, tile.index as usize, bin)
+        let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
+        let bin = lut.bin(fraction, capacity);
+        match lut.fill_pair(tile.code, level, fraction, bin, capacity) {
+            // tree indices: the parent's is the tile's over 4
+            Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
+            None => lut.offset(level as usize, tile.index as usize, bin),
+        }
     }
 
     /// The shape of every tile.
