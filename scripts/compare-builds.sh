@@ -17,6 +17,8 @@ cargo build -q --release --bin tessera --example synth_maps
 new_bin=target/release/tessera
 old_bin=target/compare-old/release/tessera
 requests=(
+  "sphere -n 10000000"
+  "sphere -n 50000"
   "sphere --map $work/maps/clear-sky_1024x512_f32.exr -n 1000000"
   "sphere --map $work/maps/city-night_1024x512_f32.exr -n 1000000"
   "sphere --map $work/maps/textured-1_1024x512_f32.exr -n 1000000"
