@@ -125,11 +125,12 @@ impl SphereLut {
     /// assert!(lut.bin_fractions[b] < 1236.0 / capacity);
     /// ```
     pub fn bin(&self, fraction: f64, capacity: f64) -> usize {
-        let accepted = accepted_count(fraction, capacity);
-        // the optimiser relaxed bin `b` on the codes below `edge_b * capacity`
+        // the optimiser relaxed bin `b` on the codes below `edge_b * capacity`,
+        // and `accepted <= ceil(x)` is `accepted - 1 < x` for whole counts
+        let below = (accepted_count(fraction, capacity) - 1.0) / capacity;
         self.bin_fractions
             .iter()
-            .position(|&edge| accepted <= (edge * capacity).ceil())
+            .position(|&edge| edge > below)
             .unwrap_or(self.bins() - 1)
     }
 
@@ -219,17 +220,21 @@ impl SphereLut {
         if level == 0 || level >= self.exact_levels as u32 {
             return None;
         }
-        let accepted = accepted_count(fraction, capacity);
+        // whole numbers below 2^53 at the per-tile levels
+        let accepted = accepted_count(fraction, capacity) as u64;
+        let code = code as u64;
+        if code >= accepted {
+            return None;
+        }
         // the bin's set: codes below `f_b * capacity` (see `bin`)
-        let in_bin = (self.bin_fractions[bin] * capacity).ceil();
-        let parents = capacity / 4.0;
-        let code = code as f64;
-        let (parent, digit) = (code % parents, (code / parents).floor());
-        // the lowest sibling the request drops, if the bin keeps it
-        let missing = ((accepted - parent) / parents).ceil().max(digit + 1.0);
-        let missing_code = parent + missing * parents;
-        (missing <= 3.0 && missing_code < in_bin && code < accepted)
-            .then(|| (missing * (missing - 1.0) / 2.0 + digit) as usize)
+        let in_bin = (self.bin_fractions[bin] * capacity).ceil() as u64;
+        let parents = capacity as u64 / 4;
+        let (digit, parent) = (code / parents, code % parents);
+        // the lowest sibling the request drops (above this one, which it
+        // keeps), if the bin keeps it
+        let missing = (accepted - parent).div_ceil(parents);
+        (missing <= 3 && parent + missing * parents < in_bin)
+            .then(|| (missing * (missing - 1) / 2 + digit) as usize)
     }
 
     /// The sibling-fill offset (tile frame, cells) of entry `pair` of the
