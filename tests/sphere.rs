@@ -14,6 +14,12 @@ use tessera::tiling::sphere::{SphereTiling, FACE_LIPSCHITZ};
 use tessera::tiling::TileSystem;
 use tessera::{engine, Sampler};
 
+/// The positions of a uniform request of `n` samples.
+fn uniform_points(n: usize) -> Vec<DVec3> {
+    let samples = Sampler::sphere().count(n).generate().unwrap();
+    samples.iter().map(|s| s.position).collect()
+}
+
 #[test]
 fn the_p_pentomino_has_exactly_two_dissections_and_both_tile_the_parent() {
     let rules = Rule::p_pentomino_rules();
@@ -229,13 +235,7 @@ fn every_bins_own_count_gets_the_set_it_was_relaxed_on() {
     let capacity = tiling.capacity(2);
     for &edge in &tiling.lut().bin_fractions[1..] {
         let n = (edge * capacity).ceil() as usize;
-        let points: Vec<DVec3> = Sampler::sphere()
-            .count(n)
-            .generate()
-            .unwrap()
-            .iter()
-            .map(|s| s.position)
-            .collect();
+        let points = uniform_points(n);
         let covering = covering_radius(&points);
         assert!(
             covering <= 3.0,
@@ -253,13 +253,7 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
     use tessera::metrics::sphere::{covering_radius, separation};
     let (mut coverings, mut worst_mesh) = (Vec::new(), 0.0f64);
     for n in (965..3840).step_by(97) {
-        let points: Vec<DVec3> = Sampler::sphere()
-            .count(n)
-            .generate()
-            .unwrap()
-            .iter()
-            .map(|s| s.position)
-            .collect();
+        let points = uniform_points(n);
         let (covering, spacing) = (covering_radius(&points), separation(&points));
         assert!(spacing >= 2.5, "N = {n}: separation {spacing:.3}");
         coverings.push(covering);
@@ -278,13 +272,7 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
 fn uniform_sets_meet_the_quality_floors_against_fibonacci() {
     // the floors of the flagship issue, measured on the shipped table
     for n in [3072, 12288] {
-        let points: Vec<DVec3> = Sampler::sphere()
-            .count(n)
-            .generate()
-            .unwrap()
-            .iter()
-            .map(|s| s.position)
-            .collect();
+        let points = uniform_points(n);
         let ours = tessera::metrics::sphere_report(&points);
         let fibonacci =
             tessera::metrics::sphere_report(&tessera::baselines::spherical_fibonacci(n));
