@@ -269,6 +269,29 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
 }
 
 #[test]
+fn per_tile_levels_keep_issue_18s_separation_floor_at_and_between_bins() {
+    // the separation steps after Lloyd pushed apart the close pairs Lloyd
+    // left (a level-4 bin read 1.85, and N = 17,270 between bins 1.73)
+    use tessera::metrics::sphere::separation;
+    let tiling = SphereTiling::default();
+    let mut counts: Vec<usize> = (3..5)
+        .flat_map(|level| {
+            let capacity = tiling.capacity(level);
+            let edges = tiling.lut().bin_fractions.clone();
+            edges
+                .into_iter()
+                .map(move |f| (f * capacity).ceil() as usize)
+        })
+        .collect();
+    // between bins, from docs/SPHERE_SWEEP.md
+    counts.extend([17_270, 20_188, 27_585, 37_694, 44_062, 51_507, 60_209]);
+    for n in counts {
+        let spacing = separation(&uniform_points(n));
+        assert!(spacing >= 2.4, "N = {n}: separation {spacing:.3}");
+    }
+}
+
+#[test]
 fn uniform_sets_meet_the_quality_floors_against_fibonacci() {
     // the floors of the flagship issue, measured on the shipped table
     for n in [3072, 12288] {
@@ -366,8 +389,8 @@ fn lloyd_relaxation_evens_spacing_and_keeps_the_density() {
     };
     let mut points = positions(Sampler::sphere().count(20_000).generate().unwrap());
     assert!(
-        mesh_ratio(&points) > 3.0,
-        "the unrelaxed set has holes here"
+        mesh_ratio(&points) > 2.8,
+        "the unrelaxed set misses issue 18's mesh-ratio floor here"
     );
     relax(&mut points, &Uniform, 10).unwrap();
     let (s, c, m) = (
