@@ -19,6 +19,7 @@ old_bin=target/compare-old/release/tessera
 requests=(
   "sphere -n 10000000"
   "sphere -n 50000"
+  "sphere -n 200000"
   "sphere --map $work/maps/clear-sky_1024x512_f32.exr -n 1000000"
   "sphere --map $work/maps/city-night_1024x512_f32.exr -n 1000000"
   "sphere --map $work/maps/textured-1_1024x512_f32.exr -n 1000000"

@@ -33,7 +33,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 4;
+pub const SPHERE_LUT_VERSION: u32 = 5;
 
 /// Offsets are stored as `i8` multiples of `1 / OFFSET_SCALE` cells from
 /// [`OFFSET_CENTRE`] (resolution 0.025 cells, 0.3 % of the point spacing;
@@ -79,18 +79,27 @@ pub struct SphereLut {
     pub root_rank: Vec<u32>,
     /// Levels `0..exact_levels` index tiles by tree position.
     pub exact_levels: u8,
-    /// Class of each child of each tile of level `exact_levels - 1`.
+    /// Levels `ring_from..exact_levels` share each offset row between the
+    /// four faces of a HEALPix ring (north, equatorial, south): turning
+    /// the sphere a quarter about its axis maps those faces, their tiles
+    /// and their neighbourhoods onto each other, so a quarter of the rows
+    /// serve (see [`SphereLut::row`]).
+    pub ring_from: u8,
+    /// The class of each tile of level `exact_levels - 1`, in fours by
+    /// parent (`entry_class[index / 4][index % 4]`): its children's
+    /// classes follow by `transitions`.
     pub entry_class: Vec<[u32; 4]>,
     /// Neighbourhood-class automaton: `transitions[class][child]`.
     pub transitions: Vec<[u32; 4]>,
     /// The density fraction (of a level's capacity) each importance bin
     /// was optimised for, increasing, the last one 1.
     pub bin_fractions: Vec<f64>,
-    /// Offsets per level (the last one serves every deeper level), indexed
-    /// `index * bins + bin`, in the tile's frame, as cells from
+    /// Offsets per level (the last one, the class table, serves every
+    /// deeper level), indexed `row * bins + bin` (see [`SphereLut::row`]), in the tile's frame, as cells from
     /// [`OFFSET_CENTRE`] times [`OFFSET_SCALE`].
     pub tables: Vec<Vec<[i8; 2]>>,
-    /// Sibling-fill offsets of the per-tile levels (none at level 0),
+    /// Sibling-fill offsets of the first per-tile levels (none at level 0;
+    /// levels from `fills.len()` on have none),
     /// indexed `parent index * FILL_PAIRS + pair` (see
     /// [`SphereLut::fill_pair`]): a request between two bins keeps a prefix
     /// of the upper bin's set, and where that drops one child of a parent,
@@ -187,7 +196,29 @@ impl SphereLut {
     /// ```
     pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
         let table = &self.tables[level.min(self.tables.len() - 1)];
-        dequantise(table[index * self.bins() + bin])
+        dequantise(table[self.row(level, index) * self.bins() + bin])
+    }
+
+    /// The offset-table row of structural index `index` at `level`: the
+    /// index itself, except at the ring-shared levels, where tiles at the
+    /// same place on the four faces of a ring share one row.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// let level = lut.ring_from as usize;
+    /// let per_face = 20 << (2 * level);
+    /// // face 1 is face 0 turned a quarter about the axis; face 4 is not
+    /// assert_eq!(lut.row(level, per_face + 7), lut.row(level, 7));
+    /// assert_ne!(lut.row(level, 4 * per_face + 7), lut.row(level, 7));
+    /// ```
+    pub fn row(&self, level: usize, index: usize) -> usize {
+        if level < self.ring_from as usize || level >= self.exact_levels as usize {
+            return index;
+        }
+        // tree indices are face-major: `face * per_face + place`
+        let per_face = ROOTS_PER_FACE << (2 * level);
+        (index / per_face / 4) * per_face + index % per_face
     }
 
     /// Which sibling-fill entry a tile of a per-tile level takes at density
@@ -217,7 +248,7 @@ impl SphereLut {
         bin: usize,
         capacity: f64,
     ) -> Option<usize> {
-        if level == 0 || level >= self.exact_levels as u32 {
+        if level == 0 || level as usize >= self.fills.len() {
             return None;
         }
         // whole numbers below 2^53 at the per-tile levels
@@ -247,7 +278,7 @@ impl SphereLut {
     /// assert!((-1.0..=3.0).contains(&o[0]) && (-1.0..=4.0).contains(&o[1]));
     /// ```
     pub fn fill(&self, level: usize, parent: usize, pair: usize) -> [f64; 2] {
-        dequantise(self.fills[level][parent * FILL_PAIRS + pair])
+        dequantise(self.fills[level][self.row(level - 1, parent) * FILL_PAIRS + pair])
     }
 
     /// Quantises an offset (cells, tile frame) for storage.
@@ -294,9 +325,6 @@ impl SphereLut {
         if ranks.iter().enumerate().any(|(i, &r)| r as usize != i) {
             return bad("root ranks must be a permutation of 0..240");
         }
-        if self.exact_levels == 0 {
-            return bad("exact_levels must be positive");
-        }
         let fractions = &self.bin_fractions;
         if fractions.last() != Some(&1.0)
             || !fractions.windows(2).all(|w| w[0] < w[1])
@@ -304,9 +332,12 @@ impl SphereLut {
         {
             return bad("bin fractions must increase from above 0 to exactly 1");
         }
-        let last_exact = roots << (2 * (self.exact_levels as usize - 1));
+        if self.exact_levels < 2 || self.ring_from > self.exact_levels {
+            return bad("need exact_levels >= 2 and ring_from <= exact_levels");
+        }
+        let last_exact_parents = roots << (2 * (self.exact_levels as usize - 2));
         let classes = self.transitions.len();
-        if self.entry_class.len() != last_exact
+        if self.entry_class.len() != last_exact_parents
             || self
                 .entry_class
                 .iter()
@@ -324,9 +355,14 @@ impl SphereLut {
             let [x, y] = dequantise(stored);
             (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
         };
+        // rows of a tree-indexed level: one a tile, a quarter at ring levels
+        let tree_rows = |level: usize| match level < self.ring_from as usize {
+            true => roots << (2 * level),
+            false => (roots / 4) << (2 * level),
+        };
         for (level, table) in self.tables.iter().enumerate() {
             let rows = if level < self.exact_levels as usize {
-                roots << (2 * level)
+                tree_rows(level)
             } else {
                 classes
             };
@@ -339,15 +375,11 @@ impl SphereLut {
                 ));
             }
         }
-        if self.fills.len() != self.exact_levels as usize {
-            return bad("need one sibling-fill table per exact level");
+        if self.fills.is_empty() || self.fills.len() > self.exact_levels as usize {
+            return bad("need a sibling-fill table per level from 0 up to at most the exact levels");
         }
         for (level, fills) in self.fills.iter().enumerate() {
-            let parents = if level == 0 {
-                0
-            } else {
-                roots << (2 * (level - 1))
-            };
+            let parents = if level == 0 { 0 } else { tree_rows(level - 1) };
             if fills.len() != parents * FILL_PAIRS {
                 return bad(&format!("sibling-fill table {level} has the wrong size"));
             }

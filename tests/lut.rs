@@ -30,4 +30,34 @@ fn bad_tables_are_refused_with_a_reason() {
     let mut far_fill = (*sphere_lut()).clone();
     far_fill.fills[1][0] = [0, i8::MIN];
     assert!(err(&far_fill.to_bytes()).contains("sibling-fill table 1 has an offset outside"));
+    // ring-shared rows past the tree-indexed levels, and a table sized for
+    // the wrong sharing
+    let mut ring = (*sphere_lut()).clone();
+    ring.ring_from = ring.exact_levels + 1;
+    assert!(err(&ring.to_bytes()).contains("ring_from"));
+    let mut unshared = (*sphere_lut()).clone();
+    unshared.ring_from = unshared.exact_levels;
+    let level = sphere_lut().ring_from;
+    assert!(err(&unshared.to_bytes()).contains(&format!("offset table {level} has the wrong size")));
+}
+
+#[test]
+fn ring_shared_rows_serve_the_four_faces_of_each_ring() {
+    // the quarter turn about the axis maps face f to f + 1 within its ring
+    // (0-3 north, 4-7 equatorial, 8-11 south): the same place on each
+    // shares one row, and the three rings' rows are disjoint
+    let lut = sphere_lut();
+    for level in lut.ring_from as usize..lut.exact_levels as usize {
+        let per_face = 20usize << (2 * level);
+        let rows = lut.tables[level].len() / lut.bins();
+        assert_eq!(rows, 3 * per_face);
+        for place in [0, 1, per_face / 2, per_face - 1] {
+            let row = |face: usize| lut.row(level, face * per_face + place);
+            for ring in 0..3 {
+                let first = row(4 * ring);
+                assert_eq!(first, ring * per_face + place);
+                assert!((1..4).all(|k| row(4 * ring + k) == first));
+            }
+        }
+    }
 }

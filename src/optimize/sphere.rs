@@ -36,7 +36,7 @@ use std::sync::Arc;
 /// # Example
 /// ```
 /// let options = tessera::optimize::sphere::BuildOptions::default();
-/// assert!(options.table_levels >= 5);
+/// assert!(options.exact_levels >= 5);
 /// ```
 #[derive(Clone, Debug, Serialize)]
 pub struct BuildOptions {
@@ -45,18 +45,23 @@ pub struct BuildOptions {
     /// Random 10x10 patches tried.
     pub patch_candidates: usize,
     /// Levels indexed by tree position (one structural index per tile).
+    /// The class table, which serves every deeper level, is relaxed on the
+    /// last of them.
     pub exact_levels: u8,
-    /// First level whose neighbourhood classes are enumerated, at most
-    /// `exact_levels`. A class level below `exact_levels` is relaxed only to
-    /// start the first shipped class table warm: started cold, level 5's
-    /// classes crowded more (separation 0.23 at N = 2·10^6 against 0.87).
+    /// First of the tree-indexed levels whose rows the four faces of a
+    /// HEALPix ring share ([`SphereLut::row`]).
+    pub ring_from: u8,
+    /// Sibling-fill tables: levels `1..fill_levels` get fills.
+    pub fill_levels: u8,
+    /// First level whose neighbourhood classes are enumerated and relaxed,
+    /// below `exact_levels`: each class level relaxes from the one above,
+    /// so the class table starts warm (started cold, its classes crowded
+    /// more: separation 0.23 at N = 2·10^6 against 0.87).
     pub class_from: u8,
     /// Deepest level whose neighbourhoods are enumerated for the automaton.
     pub class_depth: u8,
     /// Neighbourhood radius (cells) of a structural class.
     pub class_radius: u32,
-    /// Number of offset tables; the last serves every deeper level.
-    pub table_levels: u8,
     /// Importance bins per structural index (at least 6; their fractions
     /// come from [`crate::lut::bin_fractions`]).
     pub bins: u8,
@@ -64,8 +69,9 @@ pub struct BuildOptions {
     pub iterations: usize,
     /// Separation steps per table level and bin, after Lloyd.
     pub separation_steps: usize,
-    /// Levels below the class table's own on which its separation steps
-    /// also measure (it serves every deeper level).
+    /// Levels, from the first it serves (`exact_levels`) down, on which the
+    /// class table's separation steps measure (it is relaxed one level up,
+    /// on the last tree-indexed level, where that is cheaper).
     pub class_separation_depth: u8,
 }
 
@@ -74,11 +80,12 @@ impl Default for BuildOptions {
         BuildOptions {
             seed: 1,
             patch_candidates: 400,
-            exact_levels: 5,
+            exact_levels: 6,
+            ring_from: 4,
+            fill_levels: 6,
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
-            table_levels: 6,
             bins: 12,
             iterations: 32,
             separation_steps: 40,
@@ -110,13 +117,14 @@ pub struct BuildReport {
     pub transition_conflicts: usize,
     /// Transitions never observed (filled with a fallback).
     pub missing_transitions: usize,
-    /// Mean squared displacement of the last Lloyd iteration per table level.
+    /// Mean squared displacement of the last Lloyd iteration per table
+    /// (the tree-indexed levels, then the class table).
     pub lloyd_residual: Vec<f64>,
     /// Worst separation (`sqrt(n)` times the smallest distance) over the
-    /// bins of each table level, before and after the separation steps.
+    /// bins of each table, before and after the separation steps.
     pub separation: Vec<(f64, f64)>,
     /// Wall time of the Lloyd relaxation and separation steps of each
-    /// table level, seconds.
+    /// table, seconds.
     pub lloyd_seconds: Vec<f64>,
     /// Wall time of each stage, seconds.
     pub stage_seconds: Vec<(String, f64)>,
@@ -139,17 +147,21 @@ pub fn build(
     progress: Progress,
 ) -> Result<(SphereLut, BuildReport), Error> {
     if options.class_from == 0
-        || options.class_from > options.exact_levels
-        || options.table_levels <= options.exact_levels
-        || options.class_depth < options.exact_levels + 1
+        || options.class_from >= options.exact_levels
+        || options.ring_from > options.exact_levels
+        || options.fill_levels == 0
+        || options.fill_levels > options.exact_levels
+        || options.class_separation_depth == 0
+        || options.class_depth < options.exact_levels
         || options.bins < 6
         || options.class_depth > 10
-        || options.table_levels - 1 + options.class_separation_depth > options.class_depth
+        || options.exact_levels - 1 + options.class_separation_depth > options.class_depth
     {
         return Err(Error::Request(format!(
-            "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels < \
-             table_levels, exact_levels < class_depth <= 10, bins >= 6, \
-             table_levels - 1 + class_separation_depth <= class_depth)"
+            "inconsistent build options: {options:?} (need 0 < class_from < exact_levels <= \
+             class_depth <= 10, ring_from <= exact_levels, 0 < fill_levels <= exact_levels, \
+             bins >= 6, 0 < class_separation_depth, exact_levels - 1 + class_separation_depth <= \
+             class_depth)"
         )));
     }
     let mut report = BuildReport::default();
@@ -193,6 +205,7 @@ pub fn build(
         root_rank: Vec::new(),
         // provisional: tree-position indices at every level we enumerate
         exact_levels: 12,
+        ring_from: 12,
         entry_class: Vec::new(),
         transitions: Vec::new(),
         bin_fractions: crate::lut::bin_fractions(options.bins as usize),
@@ -205,16 +218,13 @@ pub fn build(
 
     let classes = classify(&enumerator, options, progress, &mut report);
     lut.exact_levels = options.exact_levels;
-    lut.entry_class = if options.class_from == options.exact_levels {
-        classes.entry
-    } else {
-        // the classes of the children of the last per-tile level's tiles
-        let parents = (options.exact_levels - 1 - options.class_from) as usize;
-        classes.per_level[parents]
-            .iter()
-            .map(|&c| classes.transitions[c as usize])
-            .collect()
-    };
+    lut.ring_from = options.ring_from;
+    // the classes of the last tree-indexed level's tiles, in fours by parent
+    let last = (options.exact_levels - 1 - options.class_from) as usize;
+    lut.entry_class = classes.per_level[last]
+        .chunks(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
     lut.transitions = classes.transitions;
     report.classes = lut.transitions.len();
     lap(&mut report, "classes");
@@ -229,7 +239,7 @@ pub fn build(
     );
     lap(&mut report, "lloyd");
 
-    lut.fills = sibling_fills(&enumerator, &lut, progress);
+    lut.fills = sibling_fills(&enumerator, &lut, options.fill_levels as u32, progress);
     lap(&mut report, "sibling fills");
     Ok((lut, report))
 }
@@ -484,7 +494,14 @@ fn torus_distance(a: [f64; 2], b: [f64; 2], period: f64) -> f64 {
     dx.min(period - dx).hypot(dy.min(period - dy))
 }
 
-/// Farthest-point ranks of the 240 roots on the sphere.
+/// Ranks of the 240 roots: farthest-point order of their ring orbits (a
+/// root and its three quarter-turn twins on the other faces of its ring),
+/// each orbit's four roots consecutive, opposite twins first. A bin's set
+/// differs between a ring's faces only where its code threshold splits
+/// the roots' ranks, and the common fractions' thresholds (multiples of
+/// 16 past a whole number of digit patterns, see
+/// [`crate::lut::COMMON_FRACTIONS`]) never split an orbit, so the rows the
+/// ring's faces share ([`SphereLut::row`]) see the same set on each face.
 fn root_ranks(lut: &SphereLut) -> Vec<u32> {
     let shape = Shape::p_pentomino();
     let tiling = SphereTiling::new(Arc::new(SphereLut {
@@ -496,16 +513,33 @@ fn root_ranks(lut: &SphereLut) -> Vec<u32> {
         .iter()
         .map(|t| tiling.face_point(t, shape.centroid()).to_vec())
         .collect();
-    farthest_point_ranks(centres.len(), |a, b| {
-        crate::density::sphere::angle_between(centres[a], centres[b])
-    })
+    // orbit `ring * 20 + place` holds the roots `(4 ring + k) * 20 + place`
+    let orbits = ROOT_COUNT / 4;
+    let member = |orbit: usize, k: usize| {
+        let (ring, place) = (orbit / ROOTS_PER_FACE, orbit % ROOTS_PER_FACE);
+        (4 * ring + k) * ROOTS_PER_FACE + place
+    };
+    // both orbits are unions of quarter turns: the distance from any root
+    // of one to the other is the same
+    let orbit_ranks = farthest_point_ranks(orbits, |a, b| {
+        (0..4)
+            .map(|k| {
+                crate::density::sphere::angle_between(centres[member(a, k)], centres[member(b, 0)])
+            })
+            .fold(f64::INFINITY, f64::min)
+    });
+    let mut ranks = vec![0; ROOT_COUNT];
+    for (orbit, &rank) in orbit_ranks.iter().enumerate() {
+        for (order, k) in [0, 2, 1, 3].into_iter().enumerate() {
+            ranks[member(orbit, k)] = 4 * rank + order as u32;
+        }
+    }
+    ranks
 }
 
 // -------------------------------------------------------------- classes ----
 
 struct Classes {
-    /// Class of each child of each tile at level `class_from - 1`.
-    entry: Vec<[u32; 4]>,
     transitions: Vec<[u32; 4]>,
     /// For each level `class_from..=class_depth`: the class of every tile.
     per_level: Vec<Vec<u32>>,
@@ -857,12 +891,7 @@ fn classify(
             }
         }
     }
-    let entry = per_level[0]
-        .chunks(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect();
     Classes {
-        entry,
         transitions,
         per_level,
     }
@@ -883,8 +912,10 @@ fn relax(
     let bins = lut.bins();
     let centroid = shape.centroid();
     let mut tables: Vec<Vec<[i8; 2]>> = Vec::new();
-    let total: u64 = (0..options.table_levels as u64)
-        .map(|l| bins as u64 * 4u64.pow(l as u32))
+    let exact = options.exact_levels as u32;
+    let class_from = options.class_from as u32;
+    let total: u64 = (0..exact)
+        .map(|l| bins as u64 * 4u64.pow(l) * if l >= class_from { 2 } else { 1 })
         .sum();
     let mut done = 0;
     // every bin of one level: rows' offsets, `row * bins + bin`, and the mean
@@ -916,55 +947,50 @@ fn relax(
         }
         (table, residual)
     };
-    // the last class table relaxed, which starts the next class level warm
-    let mut previous: Option<Vec<[f64; 2]>> = None;
-    let class_rows = |level: u32| {
-        let l = (level - options.class_from as u32) as usize;
-        class_per_level[l.min(class_per_level.len() - 1)].clone()
-    };
-    for level in 0..options.table_levels as u32 {
-        let level_clock = std::time::Instant::now();
+    let class_rows = |level: u32| class_per_level[(level - class_from) as usize].clone();
+    let classes = lut.transitions.len();
+    // the class table as relaxed so far (offsets, residual, seconds): each
+    // class level starts from the one above
+    let mut class_table: Option<(Vec<[f64; 2]>, f64, f64)> = None;
+    let steps = options.separation_steps;
+    for level in 0..exact {
         let tiles = tiling.tiles(level);
-        let classes = lut.transitions.len();
-        let (mut table, residual) = if level < options.exact_levels as u32 {
-            if level >= options.class_from as u32 {
-                let start = previous
-                    .take()
-                    .unwrap_or_else(|| vec![centroid; classes * bins]);
-                let (warm, _) = relax_level(&tiles, &class_rows(level), classes, &start);
-                previous = Some(warm);
-            }
-            let per_tile: Vec<u32> = (0..tiles.len() as u32).collect();
-            let start = vec![centroid; tiles.len() * bins];
-            relax_level(&tiles, &per_tile, tiles.len(), &start)
-        } else {
-            let start = previous
-                .take()
-                .unwrap_or_else(|| vec![centroid; classes * bins]);
-            let (table, residual) = relax_level(&tiles, &class_rows(level), classes, &start);
-            previous = Some(table.clone());
-            (table, residual)
-        };
+        if level >= class_from {
+            let clock = std::time::Instant::now();
+            let start = class_table.take().map_or_else(|| vec![centroid; classes * bins], |c| c.0);
+            let (warm, residual) = relax_level(&tiles, &class_rows(level), classes, &start);
+            done += bins as u64 * 4u64.pow(level);
+            progress("lloyd", done, total);
+            class_table = Some((warm, residual, clock.elapsed().as_secs_f64()));
+        }
+        let clock = std::time::Instant::now();
+        let rows: Vec<u32> = (0..tiles.len())
+            .map(|t| lut.row(level as usize, t) as u32)
+            .collect();
+        let row_count = rows.iter().max().map_or(0, |&r| r as usize + 1);
+        let start = vec![centroid; row_count * bins];
+        let (mut table, residual) = relax_level(&tiles, &rows, row_count, &start);
         done += bins as u64 * 4u64.pow(level);
         progress("lloyd", done, total);
         report.lloyd_residual.push(residual);
-        // a class table serves every deeper level: check it on some of them
-        let (checked, goal) = if level < options.exact_levels as u32 {
-            let rows = (0..tiles.len() as u32).collect();
-            (vec![(tiles, rows)], TILE_SEPARATION_GOAL)
-        } else {
-            let deeper = level..=level + options.class_separation_depth as u32;
-            let levels = deeper.map(|l| (tiling.tiles(l), class_rows(l)));
-            (levels.collect(), CLASS_SEPARATION_GOAL)
-        };
-        let steps = options.separation_steps;
-        let worst = separate(tiling, lut, &checked, &mut table, goal, steps);
+        let checked = [(tiles, rows)];
+        let worst = separate(tiling, lut, &checked, &mut table, TILE_SEPARATION_GOAL, steps);
         report.separation.push(worst);
-        report
-            .lloyd_seconds
-            .push(level_clock.elapsed().as_secs_f64());
+        report.lloyd_seconds.push(clock.elapsed().as_secs_f64());
         tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
     }
+    // the class table serves every deeper level: check it on some of them
+    let (mut table, residual, seconds) = class_table.expect("class_from < exact_levels");
+    let clock = std::time::Instant::now();
+    let deeper = exact..=exact - 1 + options.class_separation_depth as u32;
+    let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
+    let worst = separate(tiling, lut, &levels, &mut table, CLASS_SEPARATION_GOAL, steps);
+    report.lloyd_residual.push(residual);
+    report.separation.push(worst);
+    report
+        .lloyd_seconds
+        .push(seconds + clock.elapsed().as_secs_f64());
+    tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
     tables
 }
 
@@ -1315,17 +1341,25 @@ const FILL_RADIUS: f64 = 3.5;
 /// parent alone: in a request, the parents around it may keep all their
 /// children, and siblings relaxed together with a neighbour's hole would
 /// crowd that neighbour's child when it is kept.
-fn sibling_fills(tiling: &SphereTiling, lut: &SphereLut, progress: Progress) -> Vec<Vec<[i8; 2]>> {
-    let exact = lut.exact_levels as u32;
+fn sibling_fills(
+    tiling: &SphereTiling,
+    lut: &SphereLut,
+    fill_levels: u32,
+    progress: Progress,
+) -> Vec<Vec<[i8; 2]>> {
     let room = tiling.shape().dilated();
     let unused = SphereLut::quantise(tiling.shape().centroid());
     let mut fills = vec![Vec::new()];
-    for level in 1..exact {
+    for level in 1..fill_levels {
         let capacity = tiling.capacity(level);
         let parents = capacity as usize / 4;
         let mut by_code = tiling.tiles(level);
         by_code.sort_unstable_by_key(|t| t.code);
-        let mut table = vec![unused; parents * FILL_PAIRS];
+        // parents' rows: at ring levels a ring's first face relaxes the
+        // fills its three twins share
+        let ring = level as usize - 1 >= lut.ring_from as usize;
+        let rows = if ring { parents / 4 } else { parents };
+        let mut table = vec![unused; rows * FILL_PAIRS];
         for bin in 1..lut.bins() {
             let in_bin = (lut.bin_fractions[bin] * capacity).ceil() as usize;
             let below = (lut.bin_fractions[bin - 1] * capacity).ceil() as usize;
@@ -1341,6 +1375,9 @@ fn sibling_fills(tiling: &SphereTiling, lut: &SphereLut, progress: Progress) -> 
             let problems: Vec<Vec<Fill>> = (below + 1..in_bin)
                 .into_par_iter()
                 .map(|missing| {
+                    if ring && by_code[missing].face % 4 != 0 {
+                        return Vec::new();
+                    }
                     let (digit, parent) = (missing / parents, missing % parents);
                     let siblings: Vec<usize> = (0..digit).map(|j| parent + j * parents).collect();
                     let near = tree.within_unsorted::<SquaredEuclidean>(
@@ -1376,10 +1413,11 @@ fn sibling_fills(tiling: &SphereTiling, lut: &SphereLut, progress: Progress) -> 
                             }
                             let stored = SphereLut::quantise(room.clamp(current, 0.02));
                             let pair = digit * (digit - 1) / 2 + c / parents;
-                            let row = tile.index as usize / 4 * FILL_PAIRS + pair;
+                            let parent = lut.row(level as usize - 1, tile.index as usize / 4);
+                            let row = parent * FILL_PAIRS + pair;
                             let placed = tiling.face_point(tile, crate::lut::dequantise(stored));
-                            let unmoved =
-                                lut.tables[level as usize][tile.index as usize * lut.bins() + bin];
+                            let own = lut.row(level as usize, tile.index as usize);
+                            let unmoved = lut.tables[level as usize][own * lut.bins() + bin];
                             Fill {
                                 row,
                                 stored,
@@ -1395,7 +1433,7 @@ fn sibling_fills(tiling: &SphereTiling, lut: &SphereLut, progress: Progress) -> 
                 table[row] = o;
             }
         }
-        progress("sibling fills", level as u64, exact as u64 - 1);
+        progress("sibling fills", level as u64, fill_levels as u64 - 1);
         fills.push(table);
     }
     fills

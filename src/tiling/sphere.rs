@@ -225,10 +225,8 @@ impl SphereTiling {
         let level = tile.level as u32;
         let index = if level + 1 < lut.exact_levels as u32 {
             tile.index * 4 + child as u32
-        } else if level + 1 == lut.exact_levels as u32 {
-            lut.entry_class[tile.index as usize][child]
         } else {
-            lut.transitions[tile.index as usize][child]
+            lut.transitions[self.class_of(tile) as usize][child]
         };
         let digit = lut.child_digit[rule][child] as Code;
         SphereTile {
@@ -238,6 +236,16 @@ impl SphereTiling {
             placement: tile.placement.child(&lut.rules[rule].children[child], 2),
             index,
             code: tile.code + digit * ((ROOT_COUNT as Code) << (2 * level)),
+        }
+    }
+
+    /// The neighbourhood class of a tile of the last tree-indexed level or
+    /// deeper (its index there).
+    fn class_of(&self, tile: &SphereTile) -> u32 {
+        let lut = &*self.lut;
+        match (tile.level as u32 + 1).cmp(&(lut.exact_levels as u32)) {
+            std::cmp::Ordering::Greater => tile.index,
+            _ => lut.entry_class[tile.index as usize / 4][tile.index as usize % 4],
         }
     }
 
@@ -329,9 +337,15 @@ impl SphereTiling {
     /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
+        let capacity = self.capacity(tile.level as u32);
+        self.offset_in_bin(tile, fraction, self.lut.bin(fraction, capacity), capacity)
+    }
+
+    /// [`Self::offset`] with the fraction's bin and the level's capacity
+    /// given: a level's samples look them up once.
+    fn offset_in_bin(&self, tile: &SphereTile, fraction: f64, bin: usize, capacity: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
-        let bin = lut.bin(fraction, capacity);
+        let level = tile.level as u32;
         match lut.fill_pair(tile.code, level, fraction, bin, capacity) {
             // tree indices: the parent's is the tile's over 4
             Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
@@ -495,12 +509,16 @@ impl TileSystem for SphereTiling {
             return None;
         }
         let exact = self.lut.exact_levels as u32;
-        let listed = code_order::list_level(level, exact, |l| self.capacity(l));
+        // a tree-indexed level lists itself; deeper ones list from the last
+        // tree-indexed level on, whose tiles' classes the automaton carries
+        let first = if level >= exact { exact - 1 } else { exact };
+        let listed = code_order::list_level(level, first, |l| self.capacity(l));
         let m = self.capacity(listed) as usize;
         let listed_codes = code_order::listed_codes(&codes, m);
         let mut list = Vec::with_capacity(listed_codes.len());
         self.extend_in_code_order(listed, listed_codes.clone(), &mut list, &|_, t| {
-            Node::new(&t.placement, t.rule, t.index, t.face)
+            let index = if level >= exact { self.class_of(t) } else { t.index };
+            Node::new(&t.placement, t.rule, index, t.face)
         });
         let scale = 1.0 / Self::nside(level) as f64;
         let depth = level - listed;
@@ -531,6 +549,8 @@ impl TileSystem for SphereTiling {
             return Some(Box::new(source));
         }
         // tiles indexed by tree position: an offset per tile (and its fill)
+        let capacity = self.capacity(level);
+        let bin = self.lut.bin(fraction, capacity);
         let place = move |t: &code_order::Placed, code: usize| {
             let tile = SphereTile {
                 face: t.face,
@@ -540,7 +560,7 @@ impl TileSystem for SphereTiling {
                 index: t.class,
                 code: code as Code,
             };
-            sample(t, code, self.offset(&tile, fraction))
+            sample(t, code, self.offset_in_bin(&tile, fraction, bin, capacity))
         };
         let source = Listed::new(self, list, listed_codes.start, m, depth, place);
         Some(Box::new(source))
