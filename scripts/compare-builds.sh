@@ -8,6 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 old=${1:-00dc6bf}
 runs=${2:-9}
+pattern=${3:-}
 work=$(mktemp -d)
 trap 'git worktree remove --force "$work/old" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
 git worktree add -q --detach "$work/old" "$old"
@@ -31,6 +32,7 @@ requests=(
 median() { sort -n | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
 now() { date +%s%N; }
 for request in "${requests[@]}"; do
+  [[ "$request" == *"$pattern"* ]] || continue
   : >"$work/old.t"
   : >"$work/new.t"
   for _ in $(seq "$runs"); do

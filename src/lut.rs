@@ -112,6 +112,42 @@ pub struct SphereLut {
 /// child `d` (`s < d <= 3`), `d (d - 1) / 2 + s`.
 pub const FILL_PAIRS: usize = 6;
 
+/// A request's counts at one per-tile level, as sibling fills need them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FillCounts {
+    /// Codes the request keeps.
+    accepted: u64,
+    /// Codes its importance bin's set holds.
+    in_bin: u64,
+    /// Tiles one level up.
+    parents: u64,
+}
+
+impl FillCounts {
+    /// The sibling-fill entry of the tile of code `code` (see
+    /// [`SphereLut::fill_pair`]).
+    pub(crate) fn pair(&self, code: u64) -> Option<usize> {
+        let FillCounts {
+            accepted,
+            in_bin,
+            parents,
+        } = *self;
+        if code >= accepted {
+            return None;
+        }
+        // `x / parents` for `x <= capacity` by comparisons: this runs once a
+        // sample, and a division by a variable costs as much as the rest
+        let quarters = |x: u64| (1..=4).filter(|&k| x >= k * parents).count() as u64;
+        let digit = quarters(code);
+        let parent = code - digit * parents;
+        // the lowest sibling the request drops (above this one, which it
+        // keeps), if the bin keeps it: `ceil((accepted - parent) / parents)`
+        let missing = quarters(accepted - parent + parents - 1);
+        (missing <= 3 && parent + missing * parents < in_bin)
+            .then(|| (missing * (missing - 1) / 2 + digit) as usize)
+    }
+}
+
 impl SphereLut {
     /// The importance bin of a density fraction `f` in `(0, 1]` of a level
     /// of `capacity` tiles: the first bin whose relaxed set holds every
@@ -216,9 +252,12 @@ impl SphereLut {
         if level < self.ring_from as usize || level >= self.exact_levels as usize {
             return index;
         }
-        // tree indices are face-major: `face * per_face + place`
+        // tree indices are face-major, `face * per_face + place`, with
+        // `per_face = 5 << (2 level + 2)`: shifts and a division by a
+        // constant, as this runs once a sample
+        let face = (index >> (2 * level + 2)) / 5;
         let per_face = ROOTS_PER_FACE << (2 * level);
-        (index / per_face / 4) * per_face + index % per_face
+        index - (face - face / 4) * per_face
     }
 
     /// Which sibling-fill entry a tile of a per-tile level takes at density
@@ -248,24 +287,29 @@ impl SphereLut {
         bin: usize,
         capacity: f64,
     ) -> Option<usize> {
+        let counts = self.fill_counts(level, fraction, capacity, bin)?;
+        counts.pair(code as u64)
+    }
+
+    /// What [`Self::fill_pair`] needs of a request, computed once for all
+    /// its samples; `None` where the level has no fills.
+    pub(crate) fn fill_counts(
+        &self,
+        level: u32,
+        fraction: f64,
+        capacity: f64,
+        bin: usize,
+    ) -> Option<FillCounts> {
         if level == 0 || level as usize >= self.fills.len() {
             return None;
         }
         // whole numbers below 2^53 at the per-tile levels
-        let accepted = accepted_count(fraction, capacity) as u64;
-        let code = code as u64;
-        if code >= accepted {
-            return None;
-        }
-        // the bin's set: codes below `f_b * capacity` (see `bin`)
-        let in_bin = (self.bin_fractions[bin] * capacity).ceil() as u64;
-        let parents = capacity as u64 / 4;
-        let (digit, parent) = (code / parents, code % parents);
-        // the lowest sibling the request drops (above this one, which it
-        // keeps), if the bin keeps it
-        let missing = (accepted - parent).div_ceil(parents);
-        (missing <= 3 && parent + missing * parents < in_bin)
-            .then(|| (missing * (missing - 1) / 2 + digit) as usize)
+        Some(FillCounts {
+            accepted: accepted_count(fraction, capacity) as u64,
+            // the bin's set: codes below `f_b * capacity` (see `bin`)
+            in_bin: (self.bin_fractions[bin] * capacity).ceil() as u64,
+            parents: capacity as u64 / 4,
+        })
     }
 
     /// The sibling-fill offset (tile frame, cells) of entry `pair` of the
@@ -351,10 +395,10 @@ impl SphereLut {
             return bad("need one table per exact level and at least one class table");
         }
         // offsets stay within one cell of the pentomino's 2x3 box
-        let inside = |stored: [i8; 2]| {
-            let [x, y] = dequantise(stored);
-            (-1.0..=3.0).contains(&x) && (-1.0..=4.0).contains(&y)
-        };
+        // (x in -1..=3 and y in -1..=4 cells, stored from `OFFSET_CENTRE`
+        // in 1/40 cell; compared as stored, as this scans every entry at
+        // start-up)
+        let inside = |[x, y]: [i8; 2]| (-80..=80).contains(&x) && (-100..=100).contains(&y);
         // rows of a tree-indexed level: one a tile, a quarter at ring levels
         let tree_rows = |level: usize| match level < self.ring_from as usize {
             true => roots << (2 * level),
@@ -376,7 +420,9 @@ impl SphereLut {
             }
         }
         if self.fills.is_empty() || self.fills.len() > self.exact_levels as usize {
-            return bad("need a sibling-fill table per level from 0 up to at most the exact levels");
+            return bad(
+                "need a sibling-fill table per level from 0 up to at most the exact levels",
+            );
         }
         for (level, fills) in self.fills.iter().enumerate() {
             let parents = if level == 0 { 0 } else { tree_rows(level - 1) };

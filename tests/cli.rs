@@ -416,8 +416,10 @@ fn relax_evens_the_set_and_refuses_a_window() {
         let ratio = report.split("mesh ratio ").nth(1).expect("a report");
         ratio.trim().parse().expect("a number")
     };
-    let (before, after) = (mesh("0"), mesh("3"));
-    assert!(after < 0.8 * before && after < 2.6, "{before} -> {after}");
+    // ten iterations bring a set near a CVT's (docs/SPHERE_SWEEP.md: mesh
+    // ratio at most 2.10 over 52 counts after 10)
+    let (before, after) = (mesh("0"), mesh("10"));
+    assert!(after < 0.8 * before && after < 2.2, "{before} -> {after}");
     let out = tessera(&["sphere", "-n", "100", "--within", "0,0,10", "--relax", "2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--relax"));

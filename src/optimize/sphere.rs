@@ -957,7 +957,9 @@ fn relax(
         let tiles = tiling.tiles(level);
         if level >= class_from {
             let clock = std::time::Instant::now();
-            let start = class_table.take().map_or_else(|| vec![centroid; classes * bins], |c| c.0);
+            let start = class_table
+                .take()
+                .map_or_else(|| vec![centroid; classes * bins], |c| c.0);
             let (warm, residual) = relax_level(&tiles, &class_rows(level), classes, &start);
             done += bins as u64 * 4u64.pow(level);
             progress("lloyd", done, total);
@@ -974,7 +976,14 @@ fn relax(
         progress("lloyd", done, total);
         report.lloyd_residual.push(residual);
         let checked = [(tiles, rows)];
-        let worst = separate(tiling, lut, &checked, &mut table, TILE_SEPARATION_GOAL, steps);
+        let worst = separate(
+            tiling,
+            lut,
+            &checked,
+            &mut table,
+            TILE_SEPARATION_GOAL,
+            steps,
+        );
         report.separation.push(worst);
         report.lloyd_seconds.push(clock.elapsed().as_secs_f64());
         tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
@@ -984,7 +993,14 @@ fn relax(
     let clock = std::time::Instant::now();
     let deeper = exact..=exact - 1 + options.class_separation_depth as u32;
     let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
-    let worst = separate(tiling, lut, &levels, &mut table, CLASS_SEPARATION_GOAL, steps);
+    let worst = separate(
+        tiling,
+        lut,
+        &levels,
+        &mut table,
+        CLASS_SEPARATION_GOAL,
+        steps,
+    );
     report.lloyd_residual.push(residual);
     report.separation.push(worst);
     report
@@ -1357,7 +1373,7 @@ fn sibling_fills(
         by_code.sort_unstable_by_key(|t| t.code);
         // parents' rows: at ring levels a ring's first face relaxes the
         // fills its three twins share
-        let ring = level as usize - 1 >= lut.ring_from as usize;
+        let ring = level > lut.ring_from as u32; // the parents' level is a ring level
         let rows = if ring { parents / 4 } else { parents };
         let mut table = vec![unused; rows * FILL_PAIRS];
         for bin in 1..lut.bins() {

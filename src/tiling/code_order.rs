@@ -103,8 +103,6 @@ impl Node {
 pub(crate) struct Placed {
     /// Its placement on its level's lattice.
     pub placement: Placement,
-    /// Its rule.
-    pub rule: u8,
     /// Its structural index.
     pub class: u32,
     /// Its base face (sphere) or 0.
@@ -116,8 +114,8 @@ struct Descent {
     /// `scale^depth`: an origin's factor.
     factor: Lattice,
     /// `steps[rule * 8 + orientation]`: the descendant of a tile of that
-    /// rule at the origin so oriented, and its rule.
-    steps: Vec<(Placement, u8)>,
+    /// rule at the origin so oriented.
+    steps: Vec<Placement>,
     /// `classes[rule * classes + class]`: the descendant's class; empty
     /// for no digits (classes stay).
     classes: Vec<u32>,
@@ -132,15 +130,14 @@ impl Descent {
                 at(rule, child);
                 rule = sub.child_rule(rule, child);
             }
-            rule as u8
         };
         let steps = (0..sub.rules() * 8)
             .map(|k| {
                 let mut p = Placement::new((0, 0), Orientation::from_index(k % 8));
-                let rule = walk(k / 8, &mut |rule, child| {
+                walk(k / 8, &mut |rule, child| {
                     p = p.child(&sub.child_step(rule, child), sub.scale());
                 });
-                (p, rule)
+                p
             })
             .collect();
         let classes = match digits.is_empty() {
@@ -166,7 +163,7 @@ impl Descent {
     #[inline(always)]
     fn apply(&self, node: &Node, classes: usize) -> Placed {
         let rule = node.rule as usize;
-        let (step, last_rule) = &self.steps[rule * 8 + node.orientation.index()];
+        let step = &self.steps[rule * 8 + node.orientation.index()];
         let class = match self.classes.is_empty() {
             true => node.class,
             false => self.classes[rule * classes + node.class as usize],
@@ -179,7 +176,6 @@ impl Descent {
                 ),
                 orientation: step.orientation,
             },
-            rule: *last_rule,
             class,
             face: node.face,
         }

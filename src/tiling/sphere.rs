@@ -337,15 +337,9 @@ impl SphereTiling {
     /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
-        let capacity = self.capacity(tile.level as u32);
-        self.offset_in_bin(tile, fraction, self.lut.bin(fraction, capacity), capacity)
-    }
-
-    /// [`Self::offset`] with the fraction's bin and the level's capacity
-    /// given: a level's samples look them up once.
-    fn offset_in_bin(&self, tile: &SphereTile, fraction: f64, bin: usize, capacity: f64) -> [f64; 2] {
         let lut = &*self.lut;
-        let level = tile.level as u32;
+        let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
+        let bin = lut.bin(fraction, capacity);
         match lut.fill_pair(tile.code, level, fraction, bin, capacity) {
             // tree indices: the parent's is the tile's over 4
             Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
@@ -517,7 +511,11 @@ impl TileSystem for SphereTiling {
         let listed_codes = code_order::listed_codes(&codes, m);
         let mut list = Vec::with_capacity(listed_codes.len());
         self.extend_in_code_order(listed, listed_codes.clone(), &mut list, &|_, t| {
-            let index = if level >= exact { self.class_of(t) } else { t.index };
+            let index = if level >= exact {
+                self.class_of(t)
+            } else {
+                t.index
+            };
             Node::new(&t.placement, t.rule, index, t.face)
         });
         let scale = 1.0 / Self::nside(level) as f64;
@@ -548,19 +546,20 @@ impl TileSystem for SphereTiling {
             let source = Listed::new(self, list, listed_codes.start, m, depth, place);
             return Some(Box::new(source));
         }
-        // tiles indexed by tree position: an offset per tile (and its fill)
+        // tiles indexed by tree position: an offset per tile (and its fill),
+        // with the request's bin and fill counts found once
+        let lut = &*self.lut;
         let capacity = self.capacity(level);
-        let bin = self.lut.bin(fraction, capacity);
+        let bin = lut.bin(fraction, capacity);
+        let fills = lut.fill_counts(level, fraction, capacity, bin);
         let place = move |t: &code_order::Placed, code: usize| {
-            let tile = SphereTile {
-                face: t.face,
-                level: level as u8,
-                rule: t.rule,
-                placement: t.placement,
-                index: t.class,
-                code: code as Code,
+            let (l, index) = (level as usize, t.class as usize);
+            let offset = match fills.and_then(|f| f.pair(code as u64)) {
+                // tree indices: the parent's is the tile's over 4
+                Some(pair) => lut.fill(l, index / 4, pair),
+                None => lut.offset(l, index, bin),
             };
-            sample(t, code, self.offset_in_bin(&tile, fraction, bin, capacity))
+            sample(t, code, offset)
         };
         let source = Listed::new(self, list, listed_codes.start, m, depth, place);
         Some(Box::new(source))
