@@ -235,6 +235,22 @@ impl SphereLut {
         dequantise(table[self.row(level, index) * self.bins() + bin])
     }
 
+    /// Rows of the offset table of tree-indexed level `level`: one a tile,
+    /// a quarter of that at the ring-shared levels.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// assert_eq!(lut.rows(0), 240);
+    /// assert_eq!(lut.rows(lut.ring_from as usize), 60 << (2 * lut.ring_from));
+    /// ```
+    pub fn rows(&self, level: usize) -> usize {
+        match level < self.ring_from as usize {
+            true => ROOT_COUNT << (2 * level),
+            false => (ROOT_COUNT / 4) << (2 * level),
+        }
+    }
+
     /// The offset-table row of structural index `index` at `level`: the
     /// index itself, except at the ring-shared levels, where tiles at the
     /// same place on the four faces of a ring share one row.
@@ -399,14 +415,9 @@ impl SphereLut {
         // in 1/40 cell; compared as stored, as this scans every entry at
         // start-up)
         let inside = |[x, y]: [i8; 2]| (-80..=80).contains(&x) && (-100..=100).contains(&y);
-        // rows of a tree-indexed level: one a tile, a quarter at ring levels
-        let tree_rows = |level: usize| match level < self.ring_from as usize {
-            true => roots << (2 * level),
-            false => (roots / 4) << (2 * level),
-        };
         for (level, table) in self.tables.iter().enumerate() {
             let rows = if level < self.exact_levels as usize {
-                tree_rows(level)
+                self.rows(level)
             } else {
                 classes
             };
@@ -425,7 +436,7 @@ impl SphereLut {
             );
         }
         for (level, fills) in self.fills.iter().enumerate() {
-            let parents = if level == 0 { 0 } else { tree_rows(level - 1) };
+            let parents = if level == 0 { 0 } else { self.rows(level - 1) };
             if fills.len() != parents * FILL_PAIRS {
                 return bad(&format!("sibling-fill table {level} has the wrong size"));
             }

@@ -969,7 +969,7 @@ fn relax(
         let rows: Vec<u32> = (0..tiles.len())
             .map(|t| lut.row(level as usize, t) as u32)
             .collect();
-        let row_count = rows.iter().max().map_or(0, |&r| r as usize + 1);
+        let row_count = lut.rows(level as usize);
         let start = vec![centroid; row_count * bins];
         let (mut table, residual) = relax_level(&tiles, &rows, row_count, &start);
         done += bins as u64 * 4u64.pow(level);
@@ -1373,8 +1373,8 @@ fn sibling_fills(
         by_code.sort_unstable_by_key(|t| t.code);
         // parents' rows: at ring levels a ring's first face relaxes the
         // fills its three twins share
-        let ring = level > lut.ring_from as u32; // the parents' level is a ring level
-        let rows = if ring { parents / 4 } else { parents };
+        let rows = lut.rows(level as usize - 1);
+        let ring = rows < parents;
         let mut table = vec![unused; rows * FILL_PAIRS];
         for bin in 1..lut.bins() {
             let in_bin = (lut.bin_fractions[bin] * capacity).ceil() as usize;
