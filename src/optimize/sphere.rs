@@ -1170,9 +1170,13 @@ const CLASS_SEPARATION_GOAL: f64 = 2.6;
 /// bin by bin: every site of a bin's set closer than `goal / sqrt(n)` to
 /// its nearest neighbour is pushed half the shortfall away from it, through
 /// its row's offset (the mean push of the row's close sites, so a class row
-/// moves for its close tiles only); the steps' best offsets (largest
-/// smallest distance over `levels`, each its tiles and their rows) are
-/// kept. Returns the worst separation over the bins before and after.
+/// moves for its close tiles only). A site on top of its neighbour (two
+/// offsets clamped onto one face point) has no direction to move away in:
+/// its row moves halfway back to the tile's centroid instead, or that one
+/// pair would hold every step at separation 0 and the best step would be
+/// the first. The steps' best offsets (largest smallest distance over
+/// `levels`, each its tiles and their rows) are kept. Returns the worst
+/// separation over the bins before and after.
 fn separate(
     tiling: &SphereTiling,
     lut: &SphereLut,
@@ -1181,6 +1185,7 @@ fn separate(
     goal: f64,
     steps: usize,
 ) -> (f64, f64) {
+    let centroid = tiling.shape().centroid();
     let bins = lut.bins();
     let rows = table.len() / bins;
     let (mut before, mut after) = (f64::INFINITY, f64::INFINITY);
@@ -1234,14 +1239,20 @@ fn separate(
                     .collect();
                 worst = nearest.iter().fold(worst, |w, &(_, d)| w.min(d * scale));
                 for (k, &(j, d)) in nearest.iter().enumerate() {
-                    if d * scale >= goal || d == 0.0 {
+                    if d * scale >= goal {
+                        continue;
+                    }
+                    let (tile, row) = set[k];
+                    if d == 0.0 {
+                        push[row][0] += 0.5 * (centroid[0] - offsets[row][0]);
+                        push[row][1] += 0.5 * (centroid[1] - offsets[row][1]);
+                        pushed[row] += 1;
                         continue;
                     }
                     // half the shortfall, along the great circle away from j
                     let away = sites[k] - sites[j];
                     let tangent = (away - sites[k] * away.dot(sites[k])).normalize();
                     let target = (sites[k] + tangent * 0.5 * (goal / scale - d)).normalize();
-                    let (tile, row) = set[k];
                     let moved = to_local(tiling, tile, offsets[row], sites[k], target);
                     push[row][0] += moved[0] - offsets[row][0];
                     push[row][1] += moved[1] - offsets[row][1];
