@@ -113,6 +113,9 @@ pub struct BuildReport {
     pub new_classes_per_level: Vec<usize>,
     /// Classes first met while closing the automaton below the deepest level.
     pub classes_found_by_closure: usize,
+    /// Class rows (class and bin) Lloyd never moved, which took the offset
+    /// of the most similar relaxed class (see `borrow_offsets`).
+    pub borrowed_rows: usize,
     /// Transitions that disagreed with the majority (inconsistent automaton).
     pub transition_conflicts: usize,
     /// Transitions never observed (filled with a fallback).
@@ -232,7 +235,7 @@ pub fn build(
     lut.tables = relax(
         &enumerator,
         &lut,
-        &classes.per_level,
+        (&classes.per_level, &classes.signatures),
         options,
         progress,
         &mut report,
@@ -543,7 +546,12 @@ struct Classes {
     transitions: Vec<[u32; 4]>,
     /// For each level `class_from..=class_depth`: the class of every tile.
     per_level: Vec<Vec<u32>>,
+    /// Each class's neighbourhood signature (see [`signature`]).
+    signatures: Vec<Signature>,
 }
+
+/// A tile's neighbourhood, sorted: `(column, row, label)` of each cell.
+type Signature = Vec<(i16, i16, u32)>;
 
 /// Which lattice cell holds which tile, at one level.
 struct CellMap {
@@ -672,11 +680,11 @@ fn signature(
     owner: Owner,
     t: usize,
     radius: u32,
-) -> Vec<(i16, i16, u32)> {
+) -> Signature {
     let tile = &tiles[t];
     let nside = SphereTiling::nside(tile.level as u32);
     let digit_weight = (ROOT_COUNT as Code) << (2 * (tile.level.max(1) as u32 - 1));
-    let mut signature: Vec<(i16, i16, u32)> = window(tiling, tile, radius)
+    let mut signature: Signature = window(tiling, tile, radius)
         .into_iter()
         .map(|(cell, centre, frame)| {
             let Some((owner_index, k)) = owner(cell) else {
@@ -767,7 +775,7 @@ fn classify(
 ) -> Classes {
     let first = options.class_from as u32;
     let last = options.class_depth as u32;
-    let mut ids: HashMap<Vec<(i16, i16, u32)>, u32> = HashMap::new();
+    let mut ids: HashMap<Signature, u32> = HashMap::new();
     let mut per_level = Vec::new();
     let mut pending = std::collections::VecDeque::new();
     let mut last_classes = Vec::new();
@@ -777,7 +785,7 @@ fn classify(
         let tiles = tiling.tiles(level);
         let map = CellMap::new(tiling, &tiles, level);
         let owner = |cell: Cell| Some(map.get(cell));
-        let signatures: Vec<Vec<(i16, i16, u32)>> = (0..tiles.len())
+        let signatures: Vec<Signature> = (0..tiles.len())
             .into_par_iter()
             .map(|t| signature(tiling, &tiles, &owner, t, options.class_radius))
             .collect();
@@ -891,9 +899,14 @@ fn classify(
             }
         }
     }
+    let mut signatures = vec![Vec::new(); count];
+    for (signature, id) in ids {
+        signatures[id as usize] = signature;
+    }
     Classes {
         transitions,
         per_level,
+        signatures,
     }
 }
 
@@ -903,7 +916,7 @@ fn classify(
 fn relax(
     tiling: &SphereTiling,
     lut: &SphereLut,
-    class_per_level: &[Vec<u32>],
+    (class_per_level, signatures): (&[Vec<u32>], &[Signature]),
     options: &BuildOptions,
     progress: Progress,
     report: &mut BuildReport,
@@ -991,6 +1004,13 @@ fn relax(
     // the class table serves every deeper level: check it on some of them
     let (mut table, residual, seconds) = class_table.expect("class_from < exact_levels");
     let clock = std::time::Instant::now();
+    // the classes no enumerated level holds, met only by closing the automaton
+    let mut enumerated = vec![false; classes];
+    for class in class_per_level.iter().flatten() {
+        enumerated[*class as usize] = true;
+    }
+    let closure: Vec<usize> = (0..classes).filter(|&c| !enumerated[c]).collect();
+    report.borrowed_rows = borrow_offsets(&mut table, bins, signatures, &closure, centroid);
     let deeper = exact..=exact - 1 + options.class_separation_depth as u32;
     let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
     let worst = separate(
@@ -1008,6 +1028,65 @@ fn relax(
         .push(seconds + clock.elapsed().as_secs_f64());
     tables.push(table.iter().map(|&o| SphereLut::quantise(o)).collect());
     tables
+}
+
+/// Gives each row of the `borrowers` (classes met only below the checked
+/// level, by closing the automaton) that Lloyd never moved the offset of
+/// the relaxed class whose neighbourhood signature shares the most cells
+/// with its own. Left at its tile's centroid, such a row sat among
+/// neighbours whose offsets were fitted around other points: at
+/// N = 2·10^6 (level 7) the closest pair (0.62 / sqrt(N)) was a closure
+/// class's centroid point and a relaxed neighbour leaning toward it.
+/// Lloyd starts every row at the centroid and a row it moves never lands
+/// on it exactly, so "equal to the centroid" is "never moved". Returns
+/// the rows changed.
+fn borrow_offsets(
+    table: &mut [[f64; 2]],
+    bins: usize,
+    signatures: &[Signature],
+    borrowers: &[usize],
+    centroid: [f64; 2],
+) -> usize {
+    // which rows Lloyd moved, before any is borrowed: only those lend
+    let moved: Vec<bool> = table.iter().map(|&offset| offset != centroid).collect();
+    let mut borrowed = 0;
+    for &class in borrowers {
+        let row = |bin: usize| class * bins + bin;
+        if (0..bins).all(|bin| moved[row(bin)]) {
+            continue;
+        }
+        // every other class, most similar first (ties: the smaller id)
+        let mut donors: Vec<(usize, usize)> = (0..signatures.len())
+            .filter(|&d| d != class)
+            .map(|d| (shared_cells(&signatures[class], &signatures[d]), d))
+            .collect();
+        donors.sort_by_key(|&(shared, d)| (std::cmp::Reverse(shared), d));
+        for bin in (0..bins).filter(|&bin| !moved[row(bin)]) {
+            let lender = donors.iter().find(|&&(_, d)| moved[d * bins + bin]);
+            if let Some(&(_, donor)) = lender {
+                table[row(bin)] = table[donor * bins + bin];
+                borrowed += 1;
+            }
+        }
+    }
+    borrowed
+}
+
+/// Entries two sorted signatures have in common.
+fn shared_cells(a: &Signature, b: &Signature) -> usize {
+    let (mut i, mut j, mut shared) = (0, 0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                shared += 1;
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    shared
 }
 
 /// Step factor of the Lloyd iteration (1 is plain Lloyd).
