@@ -672,8 +672,12 @@ type Owner<'a> = &'a (dyn Fn(Cell) -> Option<(usize, usize)> + Sync);
 
 /// The neighbourhood signature of a tile: the cells of its [`window`], each
 /// labelled with the owning tile's shape cell, orientation (in the tile's
-/// frame), rule and digit, the seams the cell touches and whether it touches
-/// a three-face corner. Tiles with equal signatures get one structural index.
+/// frame), rule, digit and parent's digit, the seams the cell touches and
+/// whether it touches a three-face corner. Tiles with equal signatures get
+/// one structural index. The parent's digit is there because a request
+/// keeps a tile by its code: its digit and, below full density, its
+/// parent's rank, which that digit leads; without it the close tiles of
+/// one class wanted pushes that cancel (`examples/class_pushes.rs`).
 fn signature(
     tiling: &SphereTiling,
     tiles: &[SphereTile],
@@ -693,6 +697,13 @@ fn signature(
             let other = &tiles[owner_index];
             let orientation = other.placement.orientation.then(frame).index() as u32;
             let digit = (other.code / digit_weight) as u32;
+            // the owner's parent's digit: whether a request keeps the owner
+            // follows its parent's rank, whose leading digit this is
+            let parent_digit = if tile.level >= 2 {
+                ((other.code / (digit_weight >> 2)) % 4) as u32
+            } else {
+                0
+            };
             let mut seams = 0u32;
             for (bit, local) in LOCAL_DIRS.iter().enumerate() {
                 let face_dir = dir_of(frame.inverse().apply(*local));
@@ -719,7 +730,8 @@ fn signature(
                 | digit << 7
                 | seams << 9
                 | (corner as u32) << 13
-                | band << 14;
+                | band << 14
+                | parent_digit << 16;
             (centre.0 as i16, centre.1 as i16, label)
         })
         .collect();
