@@ -295,6 +295,18 @@ fn per_tile_levels_keep_issue_18s_separation_floor_at_and_between_bins() {
 }
 
 #[test]
+fn classes_met_only_below_the_enumerated_levels_keep_their_points_apart() {
+    // such a class borrowed the offset of a class fitted around other
+    // neighbours: at N = 2·10^6 (level 7) two of its points came within
+    // 0.74 / sqrt(N) of each other across a face edge, and 0.98 at 3·10^6
+    use tessera::metrics::sphere::separation;
+    for n in [2_000_000, 3_000_000] {
+        let spacing = separation(&uniform_points(n));
+        assert!(spacing >= 1.0, "N = {n}: separation {spacing:.3}");
+    }
+}
+
+#[test]
 fn ring_shared_levels_leave_no_hole_at_the_common_counts() {
     // levels 4 and 5 share rows between a ring's four faces; a common
     // fraction's set (powers of two, 3 * 2^k, HEALPix's 12 * 4^k) must be

@@ -73,6 +73,11 @@ pub struct BuildOptions {
     /// class table's separation steps measure (it is relaxed one level up,
     /// on the last tree-indexed level, where that is cheaper).
     pub class_separation_depth: u8,
+    /// Levels below those on which the classes met only by closing the
+    /// automaton get separation steps of their own, each class on the
+    /// first of them where it appears (level 8 alone lists 15.7 million
+    /// tiles).
+    pub closure_levels: u8,
 }
 
 impl Default for BuildOptions {
@@ -90,6 +95,7 @@ impl Default for BuildOptions {
             iterations: 32,
             separation_steps: 40,
             class_separation_depth: 1,
+            closure_levels: 2,
         }
     }
 }
@@ -126,6 +132,10 @@ pub struct BuildReport {
     /// Worst separation (`sqrt(n)` times the smallest distance) over the
     /// bins of each table, before and after the separation steps.
     pub separation: Vec<(f64, f64)>,
+    /// Per level below the class table's check: the closure classes first
+    /// met there, and the worst separation of their points before and
+    /// after separation steps that move only their rows.
+    pub closure_separation: Vec<(usize, (f64, f64))>,
     /// Wall time of the Lloyd relaxation and separation steps of each
     /// table, seconds.
     pub lloyd_seconds: Vec<f64>,
@@ -672,12 +682,13 @@ type Owner<'a> = &'a (dyn Fn(Cell) -> Option<(usize, usize)> + Sync);
 
 /// The neighbourhood signature of a tile: the cells of its [`window`], each
 /// labelled with the owning tile's shape cell, orientation (in the tile's
-/// frame), rule, digit and parent's digit, the seams the cell touches and
-/// whether it touches a three-face corner. Tiles with equal signatures get
-/// one structural index. The parent's digit is there because a request
-/// keeps a tile by its code: its digit and, below full density, its
-/// parent's rank, which that digit leads; without it the close tiles of
-/// one class wanted pushes that cancel (`examples/class_pushes.rs`).
+/// frame), rule, digit, parent's and grandparent's digits, the seams the
+/// cell touches and whether it touches a three-face corner. Tiles with
+/// equal signatures get one structural index. The ancestors' digits are
+/// there because a request keeps a tile by its code: its digit and, below
+/// full density, its parent's rank, which those digits lead; without them
+/// the close tiles of one class wanted pushes that cancel
+/// (`examples/class_pushes.rs`).
 fn signature(
     tiling: &SphereTiling,
     tiles: &[SphereTile],
@@ -697,13 +708,18 @@ fn signature(
             let other = &tiles[owner_index];
             let orientation = other.placement.orientation.then(frame).index() as u32;
             let digit = (other.code / digit_weight) as u32;
-            // the owner's parent's digit: whether a request keeps the owner
-            // follows its parent's rank, whose leading digit this is
-            let parent_digit = if tile.level >= 2 {
-                ((other.code / (digit_weight >> 2)) % 4) as u32
-            } else {
-                0
+            // the owner's parent's and grandparent's digits: whether a
+            // request keeps the owner follows its parent's rank, which they
+            // lead (the grandparent's decides where the parent's digit is
+            // the threshold's)
+            let ancestor_digit = |generations: u32| {
+                if tile.level as u32 > generations {
+                    ((other.code / (digit_weight >> (2 * generations))) % 4) as u32
+                } else {
+                    0
+                }
             };
+            let (parent_digit, grandparent_digit) = (ancestor_digit(1), ancestor_digit(2));
             let mut seams = 0u32;
             for (bit, local) in LOCAL_DIRS.iter().enumerate() {
                 let face_dir = dir_of(frame.inverse().apply(*local));
@@ -731,7 +747,8 @@ fn signature(
                 | seams << 9
                 | (corner as u32) << 13
                 | band << 14
-                | parent_digit << 16;
+                | parent_digit << 16
+                | grandparent_digit << 18;
             (centre.0 as i16, centre.1 as i16, label)
         })
         .collect();
@@ -1001,13 +1018,14 @@ fn relax(
         progress("lloyd", done, total);
         report.lloyd_residual.push(residual);
         let checked = [(tiles, rows)];
+        let every_row = vec![true; row_count];
         let worst = separate(
             tiling,
             lut,
             &checked,
             &mut table,
-            TILE_SEPARATION_GOAL,
-            steps,
+            (TILE_SEPARATION_GOAL, steps),
+            &every_row,
         );
         report.separation.push(worst);
         report.lloyd_seconds.push(clock.elapsed().as_secs_f64());
@@ -1025,16 +1043,46 @@ fn relax(
     report.borrowed_rows = borrow_offsets(&mut table, bins, signatures, &closure, centroid);
     let deeper = exact..=exact - 1 + options.class_separation_depth as u32;
     let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
+    let every_row = vec![true; classes];
     let worst = separate(
         tiling,
         lut,
         &levels,
         &mut table,
-        CLASS_SEPARATION_GOAL,
-        steps,
+        (CLASS_SEPARATION_GOAL, steps),
+        &every_row,
     );
     report.lloyd_residual.push(residual);
     report.separation.push(worst);
+    // the closure classes, each on the first level below the check where
+    // it appears, alone (every other row stays): a borrowed offset was
+    // fitted around other neighbours
+    let below = exact + options.class_separation_depth as u32;
+    let mut fitted = enumerated;
+    let mut classes_above = class_rows(below - 1);
+    for level in below..below + options.closure_levels as u32 {
+        let tiles = tiling.tiles(level);
+        let classes_here: Vec<u32> = (0..tiles.len())
+            .map(|t| lut.transitions[classes_above[t / 4] as usize][t % 4])
+            .collect();
+        let window = closure_window(tiling, &tiles, &classes_here, &fitted);
+        let movable: Vec<bool> = fitted.iter().map(|&f| !f).collect();
+        let separation = separate(
+            tiling,
+            lut,
+            &[window],
+            &mut table,
+            (CLASS_SEPARATION_GOAL, steps),
+            &movable,
+        );
+        let before = fitted.iter().filter(|&&f| f).count();
+        for &class in &classes_here {
+            fitted[class as usize] = true;
+        }
+        let first_met = fitted.iter().filter(|&&f| f).count() - before;
+        report.closure_separation.push((first_met, separation));
+        classes_above = classes_here;
+    }
     report
         .lloyd_seconds
         .push(seconds + clock.elapsed().as_secs_f64());
@@ -1266,15 +1314,17 @@ const CLASS_SEPARATION_GOAL: f64 = 2.6;
 /// its row moves halfway back to the tile's centroid instead, or that one
 /// pair would hold every step at separation 0 and the best step would be
 /// the first. The steps' best offsets (largest smallest distance over
-/// `levels`, each its tiles and their rows) are kept. Returns the worst
+/// `levels`, each its tiles and their rows) are kept. Only the sites of
+/// `movable` rows are measured and pushed, so `levels` may hold a window
+/// of a level: every tile near a movable one. Returns the worst
 /// separation over the bins before and after.
 fn separate(
     tiling: &SphereTiling,
     lut: &SphereLut,
     levels: &[(Vec<SphereTile>, Vec<u32>)],
     table: &mut [[f64; 2]],
-    goal: f64,
-    steps: usize,
+    (goal, steps): (f64, usize),
+    movable: &[bool],
 ) -> (f64, f64) {
     let centroid = tiling.shape().centroid();
     let bins = lut.bins();
@@ -1288,16 +1338,19 @@ fn separate(
             tiling.shape().dilated()
         };
         // each level's accepted tiles with their rows
-        let sets: Vec<Vec<(&SphereTile, usize)>> = levels
+        let sets: Vec<(Vec<(&SphereTile, usize)>, f64)> = levels
             .iter()
             .map(|(tiles, rows)| {
                 let capacity = ROOT_COUNT as f64 * 4f64.powi(tiles[0].level as i32);
                 let limit = lut.bin_fractions[bin] * capacity;
                 let accepted = tiles.iter().zip(rows);
-                accepted
+                let set = accepted
                     .filter(|(t, _)| (t.code as f64) < limit)
                     .map(|(t, &row)| (t, row as usize))
-                    .collect()
+                    .collect();
+                // codes are 0..capacity, each once: the whole level keeps
+                // ceil(limit) tiles, however few of them `tiles` holds
+                (set, limit.ceil().min(capacity).sqrt())
             })
             .collect();
         let mut offsets: Vec<[f64; 2]> = (0..rows).map(|r| table[r * bins + bin]).collect();
@@ -1306,18 +1359,23 @@ fn separate(
             let mut push = vec![[0.0f64; 2]; rows];
             let mut pushed = vec![0usize; rows];
             let mut worst = f64::INFINITY;
-            for set in &sets {
-                let scale = (set.len() as f64).sqrt();
+            for (set, scale) in &sets {
+                let scale = *scale;
                 let sites: Vec<DVec3> = set
                     .iter()
                     .map(|&(t, row)| tiling.face_point(t, offsets[row]).to_vec())
                     .collect();
                 let tree = site_tree(&sites);
                 let skew = skew();
+                // only movable sites are measured and pushed: a pair of
+                // fixed rows is the same at every step
                 let nearest: Vec<(usize, f64)> = sites
                     .par_iter()
                     .enumerate()
                     .map(|(k, &site)| {
+                        if !movable[set[k].1] {
+                            return (k, f64::INFINITY);
+                        }
                         let found = tree.nearest_n::<SquaredEuclidean>(
                             &(skew * site).to_array(),
                             std::num::NonZeroUsize::new(2).expect("2 > 0"),
@@ -1371,6 +1429,42 @@ fn separate(
         }
     }
     (before, after)
+}
+
+/// Centroid distance, in cells, within which a tile's point can be the
+/// nearest neighbour of another's in any bin: the lowest bin's spacing
+/// (about 3.3 cells at the class goal) plus a tile's reach (its cells
+/// and one cell of drift) on each side, with HEALPix's largest stretch.
+const WINDOW_CELLS: f64 = 12.0 * 1.6;
+
+/// The tiles of one level whose class is not yet `fitted`, with every
+/// tile near one, and their classes (`classes`, one per tile of `tiles`).
+fn closure_window(
+    tiling: &SphereTiling,
+    tiles: &[SphereTile],
+    classes: &[u32],
+    fitted: &[bool],
+) -> (Vec<SphereTile>, Vec<u32>) {
+    let centroid = tiling.shape().centroid();
+    let centres: Vec<DVec3> = tiles
+        .par_iter()
+        .map(|t| tiling.face_point(t, centroid).to_vec())
+        .collect();
+    let tree = site_tree(&centres);
+    let radius = WINDOW_CELLS / SphereTiling::nside(tiles[0].level as u32) as f64;
+    let mut near = vec![false; tiles.len()];
+    let skew = skew();
+    for t in (0..tiles.len()).filter(|&t| !fitted[classes[t] as usize]) {
+        let found = tree
+            .within_unsorted::<SquaredEuclidean>(&(skew * centres[t]).to_array(), radius * radius);
+        for n in found {
+            near[n.item as usize] = true;
+        }
+    }
+    (0..tiles.len())
+        .filter(|&t| near[t])
+        .map(|t| (tiles[t], classes[t]))
+        .unzip()
 }
 
 /// Closest a sibling-fill point may come to any other point a request using
