@@ -1075,11 +1075,11 @@ fn relax(
             (CLASS_SEPARATION_GOAL, steps),
             &movable,
         );
-        let before = fitted.iter().filter(|&&f| f).count();
+        let mut first_met = 0;
         for &class in &classes_here {
-            fitted[class as usize] = true;
+            let fresh = !std::mem::replace(&mut fitted[class as usize], true);
+            first_met += fresh as usize;
         }
-        let first_met = fitted.iter().filter(|&&f| f).count() - before;
         report.closure_separation.push((first_met, separation));
         classes_above = classes_here;
     }
