@@ -82,9 +82,11 @@ pub(crate) const CHART_HALF: f64 = 4.0;
 
 /// Largest geodesic distance from `p` to the points of the spherical convex
 /// region `{x : x · n ≥ 0 for all n in normals}` (the Voronoi cell of `p` when
-/// `normals` are `p − q` for its competitors), and a point of the region
-/// that far from `p`. Exact up to rounding.
-fn cell_radius(p: DVec3, normals: &[DVec3]) -> (f64, DVec3) {
+/// `normals` are `p − q` for its competitors), a point of the region that
+/// far from `p`, and the region in the gnomonic chart at `p` (basis
+/// [`tangent_basis`]; empty when it reaches past the chart). Exact up to
+/// rounding.
+fn cell_radius(p: DVec3, normals: &[DVec3]) -> (f64, DVec3, Poly) {
     // Fast path: a gnomonic chart centred on p. If the clipped polygon stays
     // strictly inside the chart square, it is the whole cell, which then lies
     // in the open hemisphere around p; there the distance to p is maximal at
@@ -101,9 +103,11 @@ fn cell_radius(p: DVec3, normals: &[DVec3]) -> (f64, DVec3) {
             .iter()
             .map(|u| (u[0] * u[0] + u[1] * u[1], u))
             .fold((0.0, &[0.0, 0.0]), |a, b| if b.0 > a.0 { b } else { a });
-        return (r2.sqrt().atan(), (p + u[0] * ea + u[1] * eb).normalize());
+        let farthest = (p + u[0] * ea + u[1] * eb).normalize();
+        return (r2.sqrt().atan(), farthest, poly);
     }
-    cell_radius_cube(p, normals)
+    let (radius, farthest) = cell_radius_cube(p, normals);
+    (radius, farthest, Poly::new())
 }
 
 /// General (wide cells) version of [`cell_radius`]: the cell is cut by the six
@@ -166,17 +170,33 @@ pub(crate) struct Cell {
     /// The index of the site's nearest other point (chordal; `None` for a
     /// single point).
     pub(crate) nearest: Option<usize>,
+    /// The cell in the gnomonic chart at the site (basis [`tangent_basis`]),
+    /// empty when it reaches past the chart (wider than about 76°).
+    pub(crate) chart: Poly,
+}
+
+impl Cell {
+    /// The chordal radius within which every point that can clip this
+    /// cell lies (twice the chord of its radius): a bound for the next
+    /// search of a site that moves little.
+    pub(crate) fn reach(&self) -> f64 {
+        4.0 * (0.5 * self.radius).sin()
+    }
 }
 
 /// The Voronoi cell of `points[i]` as the half-spaces `x · n ≥ 0` that
 /// bound it, into `normals` (`p − q` for its competitors `q`): the nearest
 /// neighbours from the tree, certified by the radius-of-security test, or
-/// all points when `tree` is `None`. Returns what it found of the cell.
+/// all points when `tree` is `None`. `reach` (chordal, or infinity) bounds
+/// the first search: the radius the cell is expected to need (see
+/// [`Cell::reach`]), which spares the tree and the clipping the neighbours
+/// beyond it. Returns what it found of the cell.
 pub(crate) fn cell_of(
     points: &[DVec3],
     tree: Option<&Tree3>,
     i: usize,
     normals: &mut Vec<DVec3>,
+    reach: f64,
 ) -> Cell {
     let p = points[i];
     let n = points.len();
@@ -187,11 +207,12 @@ pub(crate) fn cell_of(
         }
     };
     let cell = |normals: &[DVec3], nearest| {
-        let (radius, farthest) = cell_radius(p, normals);
+        let (radius, farthest, chart) = cell_radius(p, normals);
         Cell {
             radius,
             farthest,
             nearest,
+            chart,
         }
     };
     let everyone = |normals: &mut Vec<DVec3>| {
@@ -207,20 +228,33 @@ pub(crate) fn cell_of(
         return everyone(normals);
     };
     // 12 neighbours certify most cells of a well-spread set (a hexagonal
-    // one needs about 5), and kiddo keeps up to 20 results without a heap
-    let mut k = 12usize;
+    // one needs about 6)
+    let (mut k, mut reach) = (12usize, reach);
     loop {
         if k + 1 >= n {
             return everyone(normals);
         }
         normals.clear();
-        let found = tree.nearest_n::<SquaredEuclidean>(&p.to_array(), NonZero::new(k + 1).unwrap());
+        // a heap, then a sort of the few results: kiddo's sorted
+        // collection shifts its array on every insertion
+        let mut found = tree.nearest_n_within::<SquaredEuclidean>(
+            &p.to_array(),
+            reach * reach,
+            NonZero::new(k + 1).unwrap(),
+            false,
+        );
+        found.sort_unstable_by(|a, b| a.distance.total_cmp(&b.distance).then(a.item.cmp(&b.item)));
         for nn in &found {
             others(normals, nn.item as usize);
         }
-        let (radius, farthest) = cell_radius(p, normals);
-        // Every point not fetched is at least this far (chordal) from p.
-        let fetched = found.last().map_or(0.0, |nn| nn.distance.sqrt());
+        let (radius, farthest, chart) = cell_radius(p, normals);
+        // Every point not fetched is at least this far (chordal) from p:
+        // the k-th neighbour's distance, or all within `reach` were fetched.
+        let fetched = if found.len() > k {
+            found.last().map_or(0.0, |nn| nn.distance.sqrt())
+        } else {
+            reach
+        };
         // Points x of the clipped cell satisfy |x − p| ≤ r (chordal); a point
         // q with |q − p| ≥ 2r has |x − q| ≥ r ≥ |x − p| and cannot clip it.
         let chord = 2.0 * (0.5 * radius).sin();
@@ -230,9 +264,11 @@ pub(crate) fn cell_of(
                 radius,
                 farthest,
                 nearest: found.iter().map(|nn| nn.item as usize).find(|&j| j != i),
+                chart,
             };
         }
         k *= 2;
+        reach = f64::INFINITY;
     }
 }
 

@@ -708,7 +708,13 @@ fn neighbourhoods(
         .map_init(Vec::new, |normals, i| {
             // the covering cell's neighbours include the nearest one
             let (c, nearest) = if cover {
-                let cell = cell_of(&sorted, (n > 64).then_some(&tree), i, normals);
+                let cell = cell_of(
+                    &sorted,
+                    (n > 64).then_some(&tree),
+                    i,
+                    normals,
+                    f64::INFINITY,
+                );
                 (cell.radius * at(cell.farthest), cell.nearest)
             } else {
                 (f64::NAN, Some(nearest_other(&tree, &sorted, i)))
