@@ -65,22 +65,23 @@ where
     // tree's nodes in cache (a progressive order scatters them)
     let order = spatial_order(points);
     let mut sorted: Vec<DVec3> = order.iter().map(|&i| points[i]).collect();
+    let mut moved = sorted.clone();
     // each cell's search radius, from its previous iteration
     let mut reach = vec![f64::INFINITY; sorted.len()];
     for _ in 0..iterations {
         let tree = build_tree(&sorted);
-        let moved: Vec<(DVec3, f64)> = (0..sorted.len())
-            .into_par_iter()
-            .map_init(Vec::new, |normals, i| {
-                let cell = cell_of(&sorted, Some(&tree), i, normals, reach[i]);
+        (moved.par_iter_mut().zip(reach.par_iter_mut()).enumerate()).for_each_init(
+            Vec::new,
+            |normals, (i, (to, reach))| {
+                let cell = cell_of(&sorted, Some(&tree), i, normals, *reach);
                 let p = sorted[i];
-                let to = centroid(p, &cell.chart, split, &weight)
+                *to = centroid(p, &cell.chart, split, &weight)
                     .map_or(p, |c| (p + OVER_RELAXATION * (c - p)).normalize());
                 // the site and its neighbours move: leave a margin
-                (to, REACH_MARGIN * cell.reach() + 2.0 * p.distance(to))
-            })
-            .collect();
-        (sorted, reach) = moved.into_iter().unzip();
+                *reach = REACH_MARGIN * cell.reach() + 2.0 * p.distance(*to);
+            },
+        );
+        std::mem::swap(&mut sorted, &mut moved);
     }
     for (&i, p) in order.iter().zip(sorted) {
         points[i] = p;
