@@ -92,22 +92,30 @@ fn main() {
 
     let start = Instant::now();
     let mut rows: Vec<(usize, [Option<Row>; 6])> = Vec::new();
+    // per relaxed count: seconds to sample, then to relax 1, 3 and 10 times
+    let mut costs: Vec<(usize, f64, [f64; 3])> = Vec::new();
     for &n in &counts {
         let pairs = n <= pairs_up_to;
+        let clock = Instant::now();
         let mut points: Vec<DVec3> = (Sampler::sphere().count(n).generate().expect("uniform"))
             .into_iter()
             .map(|s| s.position)
             .collect();
+        let sampled = clock.elapsed().as_secs_f64();
         let mut row = [None; 6];
         row[0] = Some(measure(&points, pairs));
         if n <= relax_up_to {
-            let mut done = 0;
+            let (mut done, mut relaxing, mut cost) = (0, 0.0, [0.0; 3]);
             for (slot, k) in [(1, 1), (2, 3), (3, 10)] {
+                let clock = Instant::now();
                 relax(&mut points, &Uniform, k - done).expect("unit vectors");
+                relaxing += clock.elapsed().as_secs_f64();
+                cost[slot - 1] = relaxing;
                 done = k;
                 // the O(N²) measures only after the last iteration
                 row[slot] = Some(measure(&points, pairs && slot == 3));
             }
+            costs.push((n, sampled, cost));
         }
         row[4] = Some(measure(&spherical_fibonacci(n), pairs));
         if n <= ELIMINATION_UP_TO {
@@ -129,9 +137,26 @@ fn main() {
     }
     let wall = start.elapsed().as_secs_f64();
     let mut text = report(&rows, &command, wall, pairs_up_to, relax_up_to);
+    text.push_str(&cost_report(&costs));
     text.push_str(&prefix_report(&prefixes));
     std::fs::write(&out, text).expect("write the report");
     eprintln!("wrote {out}");
+}
+
+/// What relaxation costs: sampling and relaxation seconds of the relaxed
+/// counts from 10^5 up.
+fn cost_report(costs: &[(usize, f64, [f64; 3])]) -> String {
+    let mut s = String::from("\n## What relaxation costs\n\n");
+    s.push_str("Seconds of one run on this machine (2 threads, shared, so single timings are noisy): sampling `Sampler::sphere().count(N)`, then the relaxation's running total after 1, 3 and 10 iterations (`tessera::relax::relax`, what `tessera sphere --relax K` adds).\n\n");
+    s.push_str("| N | sampling s | relax 1 s | relax 3 s | relax 10 s |\n|---|---|---|---|---|\n");
+    for (n, sampled, relaxed) in costs.iter().filter(|c| c.0 >= 100_000) {
+        let _ = writeln!(
+            s,
+            "| {n} | {sampled:.3} | {:.2} | {:.2} | {:.2} |",
+            relaxed[0], relaxed[1], relaxed[2]
+        );
+    }
+    s
 }
 
 /// The prefix table: `(N, prefix length, separation, covering)` rows.
@@ -216,6 +241,18 @@ fn report(
         met(&|r| r.energy.is_some_and(|e| e <= -1.085)),
         tessera.iter().filter(|r| r.energy.is_some()).count(),
     );
+    s.push('\n');
+    for (m, name) in METHODS.iter().enumerate().take(4).skip(1) {
+        let relaxed: Vec<&Row> = rows.iter().filter_map(|(_, r)| r[m].as_ref()).collect();
+        let all = (relaxed.iter())
+            .filter(|r| r.separation >= 2.4 && r.covering <= 3.4 && r.mesh <= 2.8)
+            .count();
+        let _ = writeln!(
+            s,
+            "- {name} meets the separation, covering and mesh ratio floors together at {all} of {} counts.",
+            relaxed.len()
+        );
+    }
     let _ = writeln!(
         s,
         "\nA `-` is a measure not taken. Relaxation runs up to N = {relax_up_to}.\n"
