@@ -9,9 +9,11 @@
 //! proportional to the density itself. Each cell is integrated in the
 //! gnomonic chart of its site (area element `(1 + |u|²)^(-3/2) du`) by a
 //! degree-5, 7-point rule on a fan of triangles from the site, split in
-//! four when the density varies. Points move 1.8 times the way to their
-//! centroid (over-relaxation: faster, see `OVER_RELAXATION` in the source). Cost O(N log N) an iteration (a k-d tree
-//! and k nearest neighbours a point), parallel with rayon.
+//! four when the density differs between the site and the cell's corners.
+//! Points move 1.8 times the way to their centroid (over-relaxation:
+//! faster, see `OVER_RELAXATION` in the source). Cost O(N log N) an
+//! iteration (a k-d tree and a bounded nearest-neighbour search a point,
+//! cells visited along a Morton curve), parallel with rayon.
 //!
 //! What it changes: prefixes of the relaxed set are no longer well spread
 //! (every point moves), and the points no longer follow the density
