@@ -1,7 +1,7 @@
 //! `relax` (the `--relax K` Lloyd iterations) on a tessera set of 10^6
 //! uniform points and of 2·10^5 points following a cap of contrast 16
-//! (the density-weighted path, each cell split in four), one iteration a
-//! run, on the machine's threads. Run: `cargo bench --bench relax`.
+//! (the density-weighted path: cells across the cap's rim split in four),
+//! one iteration a run, on the machine's threads. Run: `cargo bench --bench relax`.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use glam::DVec3;

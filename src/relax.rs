@@ -117,11 +117,11 @@ fn cell_integrals(
     // no evaluations, scaled at the end. Evaluating a cap's or polygon's
     // density 28 times a triangle was two thirds of relaxing such a set.
     let at = |u: &[f64; 2]| (p + u[0] * ea + u[1] * eb).normalize();
-    let level = split
+    let flat = split
         .then(|| weight(p))
         .filter(|&w| poly.iter().all(|u| weight(at(u)) == w));
-    let split = split && level.is_none();
-    let weight = |x: DVec3| if level.is_some() { 1.0 } else { weight(x) };
+    let split = split && flat.is_none();
+    let weight = |x: DVec3| flat.map_or_else(|| weight(x), |_| 1.0);
     // ∫ w(x) x dA over the cell; x(u) = (p + a ea + b eb) / |...|
     let (mut mass, mut moment) = (0.0, DVec3::ZERO);
     let mut triangle = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
@@ -153,7 +153,7 @@ fn cell_integrals(
         triangle(ca, bc, c);
         triangle(ab, bc, ca);
     }
-    let scale = level.unwrap_or(1.0);
+    let scale = flat.unwrap_or(1.0);
     Some((mass * scale, moment * scale))
 }
 
