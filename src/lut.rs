@@ -33,7 +33,16 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 5;
+pub const SPHERE_LUT_VERSION: u32 = 6;
+
+/// zstd level sphere tables are written with: the highest, as a table is
+/// written once and read at every start (decoding speed does not depend on
+/// the level).
+const SPHERE_LUT_ZSTD_LEVEL: i32 = 22;
+
+/// Most bytes a sphere table may decode to: far above a real table (about
+/// 10 MB), it keeps a hostile file from exhausting memory.
+const SPHERE_LUT_MAX_DECODED: u64 = 1 << 28;
 
 /// Offsets are stored as `i8` multiples of `1 / OFFSET_SCALE` cells from
 /// [`OFFSET_CENTRE`] (resolution 0.025 cells, 0.3 % of the point spacing;
@@ -197,19 +206,22 @@ impl SphereLut {
     /// assert!(tessera::lut::SphereLut::from_bytes(b"not a table").is_err());
     /// ```
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, Error> {
-        let version = bytes.first().copied().unwrap_or(0) as u32;
+        let decoded = decompress(bytes)?;
+        let version = decoded.first().copied().unwrap_or(0) as u32;
         if version != SPHERE_LUT_VERSION {
             return Err(Error::Table(format!(
                 "sphere table has format version {version}, this build reads version {SPHERE_LUT_VERSION}"
             )));
         }
-        let lut: SphereLut = postcard::from_bytes(bytes)
+        let lut: SphereLut = postcard::from_bytes(&decoded)
             .map_err(|e| Error::Table(format!("sphere table does not decode: {e}")))?;
         lut.validate()?;
         Ok(lut)
     }
 
-    /// Encodes the table.
+    /// Encodes the table: postcard, compressed with zstd (a tenth of the
+    /// offsets repeat a neighbour's, so the file is about 30 % of its
+    /// decoded size).
     ///
     /// # Example
     /// ```
@@ -218,7 +230,8 @@ impl SphereLut {
     /// assert_eq!(tessera::lut::SphereLut::from_bytes(&bytes).unwrap(), *lut);
     /// ```
     pub fn to_bytes(&self) -> Vec<u8> {
-        postcard::to_allocvec(self).expect("serialising to memory cannot fail")
+        let raw = postcard::to_allocvec(self).expect("serialising to memory cannot fail");
+        zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL).expect("compressing in memory cannot fail")
     }
 
     /// The offset (tile frame, cells) of structural index `index` at
@@ -490,6 +503,30 @@ pub fn bin_fractions(count: usize) -> Vec<f64> {
     }
     fractions.sort_by(f64::total_cmp);
     fractions
+}
+
+/// The postcard bytes inside a sphere table file. A file that is not a
+/// zstd frame is an old uncompressed table, whose first byte is its format
+/// version: it is returned as is, for the version check to name.
+fn decompress(bytes: &[u8]) -> Result<Vec<u8>, Error> {
+    use std::io::Read;
+    const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+    if !bytes.starts_with(&ZSTD_MAGIC) {
+        return Ok(bytes.to_vec());
+    }
+    let corrupt = |e: std::io::Error| Error::Table(format!("sphere table does not decompress: {e}"));
+    let mut decoded = Vec::new();
+    zstd::stream::read::Decoder::new(bytes)
+        .map_err(corrupt)?
+        .take(SPHERE_LUT_MAX_DECODED + 1)
+        .read_to_end(&mut decoded)
+        .map_err(corrupt)?;
+    if decoded.len() as u64 > SPHERE_LUT_MAX_DECODED {
+        return Err(Error::Table(format!(
+            "sphere table decodes to more than {SPHERE_LUT_MAX_DECODED} bytes"
+        )));
+    }
+    Ok(decoded)
 }
 
 static SPHERE_BYTES: &[u8] = include_bytes!("../luts/sphere.lut");

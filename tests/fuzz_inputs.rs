@@ -47,10 +47,30 @@ proptest! {
     }
 
     #[test]
+    fn table_frames_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
+        // zstd's magic, then garbage: the decompressor must refuse it
+        let framed = [&[0x28, 0xb5, 0x2f, 0xfd][..], &bytes].concat();
+        prop_assert!(SphereLut::from_bytes(&framed).is_err());
+    }
+}
+
+/// The shipped table's bytes inside the zstd frame.
+fn decoded_table() -> &'static [u8] {
+    static DECODED: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    DECODED.get_or_init(|| postcard::to_allocvec(&*sphere_lut()).unwrap())
+}
+
+proptest! {
+    // each case copies, compresses and decodes a 10 MB table
+    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+    #[test]
     fn mutated_tables_decode_or_fail_cleanly(at in any::<prop::sample::Index>(), value in any::<u8>()) {
-        let mut bytes = sphere_lut().to_bytes();
-        let i = at.index(bytes.len());
-        bytes[i] = value;
+        // mutated inside the frame, so the table's own checks meet them
+        let mut decoded = decoded_table().to_vec();
+        let i = at.index(decoded.len());
+        decoded[i] = value;
+        let bytes = zstd::bulk::compress(&decoded, 1).unwrap();
         if let Ok(lut) = SphereLut::from_bytes(&bytes) {
             // a table that validates drives the sampler without panicking
             let tiling = tessera::tiling::sphere::SphereTiling::new(std::sync::Arc::new(lut));

@@ -13,10 +13,13 @@ fn bad_tables_are_refused_with_a_reason() {
     let bytes = sphere_lut().to_bytes();
     let err = |b: &[u8]| SphereLut::from_bytes(b).unwrap_err().to_string();
     assert!(err(&[]).contains("version 0"));
-    let mut wrong_version = bytes.clone();
-    wrong_version[0] = (SPHERE_LUT_VERSION + 1) as u8;
-    assert!(err(&wrong_version).contains(&format!("version {}", SPHERE_LUT_VERSION + 1)));
-    assert!(err(&bytes[..bytes.len() / 2]).contains("does not decode"));
+    let mut wrong_version = (*sphere_lut()).clone();
+    wrong_version.version += 1;
+    let expected = format!("version {}", SPHERE_LUT_VERSION + 1);
+    assert!(err(&wrong_version.to_bytes()).contains(&expected));
+    // an uncompressed table of an earlier format names its version
+    assert!(err(&[5, 0, 0]).contains("version 5"));
+    assert!(err(&bytes[..bytes.len() / 2]).contains("does not decompress"));
     // a table whose automaton points nowhere
     let mut broken = (*sphere_lut()).clone();
     broken.transitions[0][0] = u32::MAX;
