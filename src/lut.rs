@@ -231,7 +231,8 @@ impl SphereLut {
     /// ```
     pub fn to_bytes(&self) -> Vec<u8> {
         let raw = postcard::to_allocvec(self).expect("serialising to memory cannot fail");
-        zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL).expect("compressing in memory cannot fail")
+        zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL)
+            .expect("compressing in memory cannot fail")
     }
 
     /// The offset (tile frame, cells) of structural index `index` at
@@ -514,7 +515,8 @@ fn decompress(bytes: &[u8]) -> Result<Vec<u8>, Error> {
     if !bytes.starts_with(&ZSTD_MAGIC) {
         return Ok(bytes.to_vec());
     }
-    let corrupt = |e: std::io::Error| Error::Table(format!("sphere table does not decompress: {e}"));
+    let corrupt =
+        |e: std::io::Error| Error::Table(format!("sphere table does not decompress: {e}"));
     let mut decoded = Vec::new();
     zstd::stream::read::Decoder::new(bytes)
         .map_err(corrupt)?

@@ -77,8 +77,7 @@ where
             |normals, (i, (to, reach))| {
                 let cell = cell_of(&sorted, Some(&tree), i, normals, *reach);
                 let p = sorted[i];
-                *to = centroid(p, &cell.chart, split, &weight)
-                    .map_or(p, |c| (p + OVER_RELAXATION * (c - p)).normalize());
+                *to = step(p, &cell.chart, split, &weight);
                 // the site and its neighbours move: leave a margin
                 *reach = REACH_MARGIN * cell.reach() + 2.0 * p.distance(*to);
             },
@@ -89,6 +88,33 @@ where
         points[i] = p;
     }
     Ok(())
+}
+
+/// Uniform Lloyd iterations that move only the points at `movable`
+/// (indices into `points`) and hold the others in place: the table
+/// builder's sibling fills relax two or three points among about forty
+/// fixed neighbours, whose cells need not be computed.
+pub(crate) fn relax_among_fixed(points: &mut [DVec3], movable: &[usize], iterations: usize) {
+    let mut normals = Vec::new();
+    for _ in 0..iterations {
+        let tree = build_tree(points);
+        let moved: Vec<DVec3> = movable
+            .iter()
+            .map(|&i| {
+                let cell = cell_of(points, Some(&tree), i, &mut normals, f64::INFINITY);
+                step(points[i], &cell.chart, false, &|_| 1.0)
+            })
+            .collect();
+        for (&i, p) in movable.iter().zip(moved) {
+            points[i] = p;
+        }
+    }
+}
+
+/// Where one over-relaxed Lloyd step moves `p`, whose Voronoi cell is
+/// `poly` in its gnomonic chart: `p` itself when the cell has no centroid.
+fn step(p: DVec3, poly: &Poly, split: bool, weight: &impl Fn(DVec3) -> f64) -> DVec3 {
+    centroid(p, poly, split, weight).map_or(p, |c| (p + OVER_RELAXATION * (c - p)).normalize())
 }
 
 /// The `weight`-weighted centroid of the Voronoi cell of `p`, given in
@@ -254,6 +280,31 @@ mod tests {
             "{share} against {}",
             cap.mass_fraction()
         );
+    }
+
+    /// Moving a few points among fixed ones is relaxing all of them and
+    /// putting the others back, iteration by iteration (what the table
+    /// builder's sibling fills did before).
+    #[test]
+    fn relaxing_among_fixed_points_moves_only_the_movable() {
+        let start = crate::baselines::spherical_fibonacci(40);
+        let movable = [3, 17, 18];
+        let mut all = start.clone();
+        for _ in 0..4 {
+            let before = all.clone();
+            relax(&mut all, &Uniform, 1).unwrap();
+            for k in (0..all.len()).filter(|k| !movable.contains(k)) {
+                all[k] = before[k];
+            }
+        }
+        let mut some = start.clone();
+        relax_among_fixed(&mut some, &movable, 4);
+        for (k, (a, b)) in all.iter().zip(&some).enumerate() {
+            assert!((*a - *b).length() < 1e-12, "point {k}: {a} against {b}");
+        }
+        assert!(movable
+            .iter()
+            .all(|&k| (some[k] - start[k]).length() > 1e-6));
     }
 
     /// Weights sum to 1 and reproduce a quadratic's integral.

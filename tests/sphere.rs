@@ -273,10 +273,11 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
 fn per_tile_levels_keep_issue_18s_separation_floor_at_and_between_bins() {
     // the separation steps after Lloyd pushed apart the close pairs Lloyd
     // left (a level-4 bin read 1.85, and N = 17,270 between bins 1.73);
-    // level 5, per tile since format 5, read 1.62-2.28 with classes
+    // level 5, per tile since format 5, read 1.62-2.28 with classes, and
+    // level 6, per tile since format 6, 1.98-2.25
     use tessera::metrics::sphere::separation;
     let tiling = SphereTiling::default();
-    let mut counts: Vec<usize> = (3..6)
+    let mut counts: Vec<usize> = (3..7)
         .flat_map(|level| {
             let capacity = tiling.capacity(level);
             let edges = tiling.lut().bin_fractions.clone();
@@ -288,6 +289,10 @@ fn per_tile_levels_keep_issue_18s_separation_floor_at_and_between_bins() {
     // between bins, from docs/SPHERE_SWEEP.md
     counts.extend([17_270, 20_188, 27_585, 37_694, 44_062, 51_507, 60_209]);
     counts.extend([61_500, 70_381, 82_272, 112_421, 131_415, 179_571, 245_375]);
+    counts.extend([
+        246_000, 286_832, 335_292, 391_941, 458_160, 535_567, 626_052,
+    ]);
+    counts.extend([731_824, 855_467]);
     for n in counts {
         let spacing = separation(&uniform_points(n));
         assert!(spacing >= 2.4, "N = {n}: separation {spacing:.3}");
@@ -308,13 +313,14 @@ fn classes_met_only_below_the_enumerated_levels_keep_their_points_apart() {
 
 #[test]
 fn ring_shared_levels_leave_no_hole_at_the_common_counts() {
-    // levels 4 and 5 share rows between a ring's four faces; a common
+    // levels 4-6 share rows between a ring's four faces; a common
     // fraction's set (powers of two, 3 * 2^k, HEALPix's 12 * 4^k) must be
     // the same on each face, or the shared offsets leave holes (N = 49,152
     // read covering 3.56 while root ranks split the ring orbits)
     use tessera::metrics::sphere::covering_radius;
     for n in [
-        16_384, 24_576, 32_768, 49_152, 65_536, 98_304, 131_072, 196_608,
+        16_384, 24_576, 32_768, 49_152, 65_536, 98_304, 131_072, 196_608, 262_144, 393_216,
+        524_288, 786_432,
     ] {
         let covering = covering_radius(&uniform_points(n));
         assert!(covering <= 3.2, "N = {n}: covering {covering:.3}");

@@ -46,7 +46,7 @@ pub struct BuildOptions {
     pub patch_candidates: usize,
     /// Levels indexed by tree position (one structural index per tile).
     /// The class table, which serves every deeper level, is relaxed on the
-    /// last of them.
+    /// last of them above `class_depth`.
     pub exact_levels: u8,
     /// First of the tree-indexed levels whose rows the four faces of a
     /// HEALPix ring share ([`SphereLut::row`]).
@@ -67,6 +67,10 @@ pub struct BuildOptions {
     pub bins: u8,
     /// Lloyd iterations per level and bin.
     pub iterations: usize,
+    /// Lloyd iterations per bin of a tree-indexed level at or below
+    /// `class_depth`: its rows start from their classes' offsets, which
+    /// already fit, so a few iterations refit each to its own tile.
+    pub deep_tile_iterations: usize,
     /// Separation steps per table level and bin, after Lloyd.
     pub separation_steps: usize,
     /// Levels, from the first it serves (`exact_levels`) down, on which the
@@ -85,14 +89,15 @@ impl Default for BuildOptions {
         BuildOptions {
             seed: 1,
             patch_candidates: 400,
-            exact_levels: 6,
+            exact_levels: 7,
             ring_from: 4,
-            fill_levels: 6,
+            fill_levels: 7,
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
             bins: 12,
             iterations: 32,
+            deep_tile_iterations: 8,
             separation_steps: 40,
             class_separation_depth: 1,
             closure_levels: 2,
@@ -143,6 +148,13 @@ pub struct BuildReport {
     pub stage_seconds: Vec<(String, f64)>,
 }
 
+/// First level the class table's separation steps measure on: the first
+/// level it serves, or the deepest enumerated one when a tree-indexed level
+/// lies there too (the class table is relaxed on the levels above it).
+fn class_check(options: &BuildOptions) -> u32 {
+    options.exact_levels.min(options.class_depth) as u32
+}
+
 /// Progress callback: stage name, work done, work total.
 pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
 
@@ -165,16 +177,18 @@ pub fn build(
         || options.fill_levels == 0
         || options.fill_levels > options.exact_levels
         || options.class_separation_depth == 0
-        || options.class_depth < options.exact_levels
+        || options.class_depth + 1 < options.exact_levels
+        || options.class_from >= options.class_depth
         || options.bins < 6
         || options.class_depth > 10
-        || options.exact_levels - 1 + options.class_separation_depth > options.class_depth
+        || class_check(options) - 1 + options.class_separation_depth as u32
+            > options.class_depth as u32
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < class_from < exact_levels <= \
-             class_depth <= 10, ring_from <= exact_levels, 0 < fill_levels <= exact_levels, \
-             bins >= 6, 0 < class_separation_depth, exact_levels - 1 + class_separation_depth <= \
-             class_depth)"
+             class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
+             0 < fill_levels <= exact_levels, bins >= 6, 0 < class_separation_depth, \
+             min(exact_levels, class_depth) - 1 + class_separation_depth <= class_depth)"
         )));
     }
     let mut report = BuildReport::default();
@@ -956,29 +970,26 @@ fn relax(
     let mut tables: Vec<Vec<[i8; 2]>> = Vec::new();
     let exact = options.exact_levels as u32;
     let class_from = options.class_from as u32;
+    let check = class_check(options);
+    let class_levels = class_from..check;
     let total: u64 = (0..exact)
-        .map(|l| bins as u64 * 4u64.pow(l) * if l >= class_from { 2 } else { 1 })
+        .map(|l| bins as u64 * 4u64.pow(l) * if class_levels.contains(&l) { 2 } else { 1 })
         .sum();
     let mut done = 0;
     // every bin of one level: rows' offsets, `row * bins + bin`, and the mean
     // residual over the bins
-    let relax_level = |tiles: &[SphereTile], rows: &[u32], row_count: usize, start: &[[f64; 2]]| {
+    let relax_level = |tiles: &[SphereTile],
+                       rows: &[u32],
+                       row_count: usize,
+                       start: &[[f64; 2]],
+                       iterations: usize| {
         let level = tiles[0].level as u32;
         let mut table = start.to_vec();
         let mut residual = 0.0;
         for bin in 0..bins {
             let fraction = lut.bin_fractions[bin];
             let (offsets, r) = relax_bin(
-                tiling,
-                tiles,
-                rows,
-                row_count,
-                bins,
-                bin,
-                fraction,
-                start,
-                options.iterations,
-                level,
+                tiling, tiles, rows, row_count, bins, bin, fraction, start, iterations, level,
             );
             residual += r / bins as f64;
             for row in 0..row_count {
@@ -997,12 +1008,18 @@ fn relax(
     let steps = options.separation_steps;
     for level in 0..exact {
         let tiles = tiling.tiles(level);
-        if level >= class_from {
+        if class_levels.contains(&level) {
             let clock = std::time::Instant::now();
             let start = class_table
                 .take()
                 .map_or_else(|| vec![centroid; classes * bins], |c| c.0);
-            let (warm, residual) = relax_level(&tiles, &class_rows(level), classes, &start);
+            let (warm, residual) = relax_level(
+                &tiles,
+                &class_rows(level),
+                classes,
+                &start,
+                options.iterations,
+            );
             done += bins as u64 * 4u64.pow(level);
             progress("lloyd", done, total);
             class_table = Some((warm, residual, clock.elapsed().as_secs_f64()));
@@ -1012,8 +1029,22 @@ fn relax(
             .map(|t| lut.row(level as usize, t) as u32)
             .collect();
         let row_count = lut.rows(level as usize);
-        let start = vec![centroid; row_count * bins];
-        let (mut table, residual) = relax_level(&tiles, &rows, row_count, &start);
+        let (start, iterations) = match &class_table {
+            // a level the classes were enumerated on: each row starts from
+            // the offsets of its first tile's class
+            Some((class_offsets, ..)) if level >= check => {
+                let mut start = vec![centroid; row_count * bins];
+                let tile_classes = class_rows(level);
+                for t in (0..tiles.len()).rev() {
+                    let (row, class) = (rows[t] as usize, tile_classes[t] as usize);
+                    start[row * bins..(row + 1) * bins]
+                        .copy_from_slice(&class_offsets[class * bins..(class + 1) * bins]);
+                }
+                (start, options.deep_tile_iterations)
+            }
+            _ => (vec![centroid; row_count * bins], options.iterations),
+        };
+        let (mut table, residual) = relax_level(&tiles, &rows, row_count, &start, iterations);
         done += bins as u64 * 4u64.pow(level);
         progress("lloyd", done, total);
         report.lloyd_residual.push(residual);
@@ -1041,7 +1072,7 @@ fn relax(
     }
     let closure: Vec<usize> = (0..classes).filter(|&c| !enumerated[c]).collect();
     report.borrowed_rows = borrow_offsets(&mut table, bins, signatures, &closure, centroid);
-    let deeper = exact..=exact - 1 + options.class_separation_depth as u32;
+    let deeper = check..=check - 1 + options.class_separation_depth as u32;
     let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
     let every_row = vec![true; classes];
     let worst = separate(
@@ -1057,7 +1088,7 @@ fn relax(
     // the closure classes, each on the first level below the check where
     // it appears, alone (every other row stays): a borrowed offset was
     // fitted around other neighbours
-    let below = exact + options.class_separation_depth as u32;
+    let below = check + options.class_separation_depth as u32;
     let mut fitted = enumerated;
     let mut classes_above = class_rows(below - 1);
     for level in below..below + options.closure_levels as u32 {
@@ -1542,8 +1573,8 @@ fn site_tree(sites: &[DVec3]) -> ImmutableKdTree<f64, u32, 3, 32> {
 
 /// Lloyd iterations of each sibling-fill problem.
 const FILL_ITERATIONS: usize = 10;
-/// Radius, in point spacings, of the neighbourhood a sibling-fill problem
-/// relaxes in.
+/// Radius, in point spacings, about the missing point and each sibling,
+/// of the neighbourhood a sibling-fill problem relaxes in.
 const FILL_RADIUS: f64 = 3.5;
 
 /// The sibling-fill tables (see [`SphereLut::fills`]). For each bin of a
@@ -1592,26 +1623,28 @@ fn sibling_fills(
                     }
                     let (digit, parent) = (missing / parents, missing % parents);
                     let siblings: Vec<usize> = (0..digit).map(|j| parent + j * parents).collect();
-                    let near = tree.within_unsorted::<SquaredEuclidean>(
-                        &(skew() * sites[missing]).to_array(),
-                        radius2,
-                    );
-                    let local: Vec<usize> = near
-                        .iter()
+                    // the neighbours of the missing site and of each sibling:
+                    // near the polar caps' corners siblings lie up to 3.5
+                    // spacings apart, so a radius about the missing site
+                    // alone left a sibling out, unmoved while the others
+                    // closed in on it (0.78 / sqrt(N) at N = 731,824)
+                    let mut local: Vec<usize> = (siblings.iter().chain([&missing]))
+                        .flat_map(|&f| {
+                            tree.within_unsorted::<SquaredEuclidean>(
+                                &(skew() * sites[f]).to_array(),
+                                radius2,
+                            )
+                        })
                         .map(|n| n.item as usize)
                         .filter(|&c| c != missing)
                         .collect();
+                    local.sort_unstable();
+                    local.dedup();
                     let mut points: Vec<DVec3> = local.iter().map(|&c| sites[c]).collect();
-                    for _ in 0..FILL_ITERATIONS {
-                        let before = points.clone();
-                        crate::relax::relax(&mut points, &crate::density::Uniform, 1)
-                            .expect("sites are unit vectors");
-                        for (k, &c) in local.iter().enumerate() {
-                            if !siblings.contains(&c) {
-                                points[k] = before[k];
-                            }
-                        }
-                    }
+                    let movable: Vec<usize> = (0..local.len())
+                        .filter(|&k| siblings.contains(&local[k]))
+                        .collect();
+                    crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS);
                     local
                         .iter()
                         .zip(points)
