@@ -9,6 +9,14 @@ fn the_shipped_table_round_trips() {
 }
 
 #[test]
+fn the_embedded_table_is_valid() {
+    // `sphere_lut()` decodes its offset tables as requests reach them,
+    // without the checks `from_bytes` makes
+    let bytes = include_bytes!("../luts/sphere.lut");
+    assert_eq!(SphereLut::from_bytes(bytes).unwrap(), *sphere_lut());
+}
+
+#[test]
 fn bad_tables_are_refused_with_a_reason() {
     let bytes = sphere_lut().to_bytes();
     let err = |b: &[u8]| SphereLut::from_bytes(b).unwrap_err().to_string();
@@ -25,7 +33,7 @@ fn bad_tables_are_refused_with_a_reason() {
     broken.transitions[0][0] = u32::MAX;
     assert!(err(&broken.to_bytes()).contains("missing class"));
     let mut far = (*sphere_lut()).clone();
-    far.tables[0][0] = [i8::MAX, 0];
+    far.tables[0][0][0] = [i8::MAX, 0];
     assert!(err(&far.to_bytes()).contains("outside"));
     let mut short = (*sphere_lut()).clone();
     short.fills[2].pop();
@@ -52,7 +60,7 @@ fn ring_shared_rows_serve_the_four_faces_of_each_ring() {
     let lut = sphere_lut();
     for level in lut.ring_from as usize..lut.exact_levels as usize {
         let per_face = 20usize << (2 * level);
-        let rows = lut.tables[level].len() / lut.bins();
+        let rows = lut.tables[level][0].len();
         assert_eq!(rows, 3 * per_face);
         for place in [0, 1, per_face / 2, per_face - 1] {
             let row = |face: usize| lut.row(level, face * per_face + place);

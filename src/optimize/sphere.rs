@@ -17,7 +17,7 @@
 
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
-use crate::lut::{SphereLut, FILL_PAIRS, SPHERE_LUT_VERSION};
+use crate::lut::{Offsets, SphereLut, FILL_PAIRS, SPHERE_LUT_VERSION};
 use crate::polyomino::exact_cover;
 use crate::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
 use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
@@ -172,7 +172,7 @@ pub fn build(
     progress: Progress,
 ) -> Result<(SphereLut, BuildReport), Error> {
     if options.class_from == 0
-        || options.class_from >= options.exact_levels
+        || options.class_from + 2 > options.exact_levels
         || options.ring_from > options.exact_levels
         || options.fill_levels == 0
         || options.fill_levels > options.exact_levels
@@ -185,7 +185,7 @@ pub fn build(
             > options.class_depth as u32
     {
         return Err(Error::Request(format!(
-            "inconsistent build options: {options:?} (need 0 < class_from < exact_levels <= \
+            "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
              0 < fill_levels <= exact_levels, bins >= 6, 0 < class_separation_depth, \
              min(exact_levels, class_depth) - 1 + class_separation_depth <= class_depth)"
@@ -246,9 +246,10 @@ pub fn build(
     let classes = classify(&enumerator, options, progress, &mut report);
     lut.exact_levels = options.exact_levels;
     lut.ring_from = options.ring_from;
-    // the classes of the last tree-indexed level's tiles, in fours by parent
-    let last = (options.exact_levels - 1 - options.class_from) as usize;
-    lut.entry_class = classes.per_level[last]
+    // the classes of the tiles one level above the last tree-indexed one,
+    // in fours by parent
+    let entry = (options.exact_levels - 2 - options.class_from) as usize;
+    lut.entry_class = classes.per_level[entry]
         .chunks(4)
         .map(|c| [c[0], c[1], c[2], c[3]])
         .collect();
@@ -263,12 +264,33 @@ pub fn build(
         options,
         progress,
         &mut report,
-    );
+    )
+    .iter()
+    .map(|table| by_bin(table, options.bins as usize))
+    .collect();
     lap(&mut report, "lloyd");
 
-    lut.fills = sibling_fills(&enumerator, &lut, options.fill_levels as u32, progress);
+    let fills = sibling_fills(&enumerator, &lut, options.fill_levels as u32, progress);
+    lut.fills = fills.into_iter().map(Offsets::from).collect();
     lap(&mut report, "sibling fills");
     Ok((lut, report))
+}
+
+/// A level's offsets, relaxed as `row * bins + bin`, split into the table
+/// of each bin (a request reads one).
+fn by_bin(table: &[[i8; 2]], bins: usize) -> Vec<Offsets> {
+    (0..bins)
+        .map(|bin| {
+            Offsets::from(
+                table
+                    .iter()
+                    .skip(bin)
+                    .step_by(bins)
+                    .copied()
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .collect()
 }
 
 // ---------------------------------------------------------------- patch ----
@@ -1662,7 +1684,7 @@ fn sibling_fills(
                             let row = parent * FILL_PAIRS + pair;
                             let placed = tiling.face_point(tile, crate::lut::dequantise(stored));
                             let own = lut.row(level as usize, tile.index as usize);
-                            let unmoved = lut.tables[level as usize][own * lut.bins() + bin];
+                            let unmoved = lut.tables[level as usize][bin][own];
                             Fill {
                                 row,
                                 stored,

@@ -245,7 +245,12 @@ impl SphereTiling {
         let lut = &*self.lut;
         match (tile.level as u32 + 1).cmp(&(lut.exact_levels as u32)) {
             std::cmp::Ordering::Greater => tile.index,
-            _ => lut.entry_class[tile.index as usize / 4][tile.index as usize % 4],
+            _ => {
+                // the parent's class, from level `exact_levels - 2`
+                let parent = tile.index as usize / 4;
+                let class = lut.entry_class[parent / 4][parent % 4];
+                lut.transitions[class as usize][tile.index as usize % 4]
+            }
         }
     }
 
