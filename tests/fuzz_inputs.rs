@@ -3,7 +3,7 @@
 
 use proptest::prelude::*;
 use tessera::io::points::read_points_from;
-use tessera::lut::{sphere_lut, SphereLut};
+use tessera::lut::SphereLut;
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]

@@ -239,18 +239,21 @@ impl SphereTiling {
         }
     }
 
-    /// The neighbourhood class of a tile of the last tree-indexed level or
-    /// deeper (its index there).
+    /// The neighbourhood class of a tile of level `exact_levels - 2` (the
+    /// level `entry_class` lists) or deeper: for the deep levels its index.
     fn class_of(&self, tile: &SphereTile) -> u32 {
         let lut = &*self.lut;
-        match (tile.level as u32 + 1).cmp(&(lut.exact_levels as u32)) {
-            std::cmp::Ordering::Greater => tile.index,
-            _ => {
-                // the parent's class, from level `exact_levels - 2`
-                let parent = tile.index as usize / 4;
-                let class = lut.entry_class[parent / 4][parent % 4];
-                lut.transitions[class as usize][tile.index as usize % 4]
-            }
+        let entry = |index: usize| lut.entry_class[index / 4][index % 4];
+        let (next, index) = (tile.level as u32 + 1, tile.index as usize);
+        let exact = lut.exact_levels as u32;
+        // `next`: the level of the tile's children
+        if next < exact {
+            entry(index)
+        } else if next == exact {
+            // the last tree-indexed level: its parent's class, carried down
+            lut.transitions[entry(index / 4) as usize][index % 4]
+        } else {
+            tile.index
         }
     }
 
@@ -508,9 +511,10 @@ impl TileSystem for SphereTiling {
             return None;
         }
         let exact = self.lut.exact_levels as u32;
-        // a tree-indexed level lists itself; deeper ones list from the last
-        // tree-indexed level on, whose tiles' classes the automaton carries
-        let first = if level >= exact { exact - 1 } else { exact };
+        // a tree-indexed level lists itself; deeper ones list from the level
+        // whose classes the table holds (`entry_class`), and the automaton
+        // carries them down
+        let first = if level >= exact { exact - 2 } else { exact };
         let listed = code_order::list_level(level, first, |l| self.capacity(l));
         let m = self.capacity(listed) as usize;
         let listed_codes = code_order::listed_codes(&codes, m);
