@@ -64,11 +64,26 @@ fn ring_shared_rows_serve_the_four_faces_of_each_ring() {
         assert_eq!(rows, 3 * per_face);
         for place in [0, 1, per_face / 2, per_face - 1] {
             let row = |face: usize| lut.row(level, face * per_face + place);
+            // `place` is root `place >> 2 level` of the face, and the path
+            // `place & (4^level - 1)` below it; rows are path-major
+            let (root, path) = (place >> (2 * level), place & ((1 << (2 * level)) - 1));
             for ring in 0..3 {
                 let first = row(4 * ring);
-                assert_eq!(first, ring * per_face + place);
+                assert_eq!(first, path * 60 + ring * 20 + root);
                 assert!((1..4).all(|k| row(4 * ring + k) == first));
             }
         }
+    }
+}
+
+#[test]
+fn every_row_of_a_per_tile_level_serves_some_tile() {
+    let lut = sphere_lut();
+    for level in 0..lut.exact_levels as usize {
+        let mut used = vec![false; lut.rows(level)];
+        for index in 0..240usize << (2 * level) {
+            used[lut.row(level, index)] = true;
+        }
+        assert!(used.iter().all(|&u| u), "level {level} leaves a row unused");
     }
 }

@@ -109,6 +109,27 @@ pub(crate) struct Placed {
     pub face: u8,
 }
 
+/// What a listed tile's structural index says of its descendants'.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Indexing {
+    /// A neighbourhood class: the descendant's follows the automaton
+    /// ([`Subdivision::child_class`]).
+    Classes,
+    /// A position in the subdivision tree: child `c` of index `i` has
+    /// index `i * arity + c`.
+    Tree,
+}
+
+/// How a descent maps the listed tile's index to its descendant's.
+enum Indices {
+    /// No digits: the index stays.
+    Same,
+    /// `table[rule * classes + class]`: the descendant's class.
+    Classes(Vec<u32>),
+    /// `index * factor + suffix[rule]`: the descendant's tree index.
+    Tree { factor: u32, suffix: Vec<u32> },
+}
+
 /// The descent along fixed digits, tabulated.
 struct Descent {
     /// `scale^depth`: an origin's factor.
@@ -116,14 +137,13 @@ struct Descent {
     /// `steps[rule * 8 + orientation]`: the descendant of a tile of that
     /// rule at the origin so oriented.
     steps: Vec<Placement>,
-    /// `classes[rule * classes + class]`: the descendant's class; empty
-    /// for no digits (classes stay).
-    classes: Vec<u32>,
+    /// The descendant's structural index.
+    indices: Indices,
 }
 
 impl Descent {
     /// The descent along `digits` (shallowest first).
-    fn new(sub: &impl Subdivision, digits: &[usize]) -> Descent {
+    fn new(sub: &impl Subdivision, digits: &[usize], indexing: Indexing) -> Descent {
         let walk = |mut rule: usize, at: &mut dyn FnMut(usize, usize)| {
             for &digit in digits {
                 let child = sub.child_of_digit(rule, digit);
@@ -140,22 +160,36 @@ impl Descent {
                 p
             })
             .collect();
-        let classes = match digits.is_empty() {
-            true => Vec::new(),
-            false => (0..sub.rules() * sub.classes())
-                .map(|k| {
-                    let mut class = k % sub.classes();
-                    walk(k / sub.classes(), &mut |_, child| {
-                        class = sub.child_class(class, child)
-                    });
-                    class as u32
-                })
-                .collect(),
+        let indices = match (digits.is_empty(), indexing) {
+            (true, _) => Indices::Same,
+            (false, Indexing::Classes) => Indices::Classes(
+                (0..sub.rules() * sub.classes())
+                    .map(|k| {
+                        let mut class = k % sub.classes();
+                        walk(k / sub.classes(), &mut |_, child| {
+                            class = sub.child_class(class, child)
+                        });
+                        class as u32
+                    })
+                    .collect(),
+            ),
+            (false, Indexing::Tree) => Indices::Tree {
+                factor: (sub.arity() as u32).pow(digits.len() as u32),
+                suffix: (0..sub.rules())
+                    .map(|rule| {
+                        let mut suffix = 0;
+                        walk(rule, &mut |_, child| {
+                            suffix = suffix * sub.arity() as u32 + child as u32
+                        });
+                        suffix
+                    })
+                    .collect(),
+            },
         };
         Descent {
             factor: sub.scale().pow(digits.len() as u32),
             steps,
-            classes,
+            indices,
         }
     }
 
@@ -164,9 +198,10 @@ impl Descent {
     fn apply(&self, node: &Node, classes: usize) -> Placed {
         let rule = node.rule as usize;
         let step = &self.steps[rule * 8 + node.orientation.index()];
-        let class = match self.classes.is_empty() {
-            true => node.class,
-            false => self.classes[rule * classes + node.class as usize],
+        let class = match &self.indices {
+            Indices::Same => node.class,
+            Indices::Classes(table) => table[rule * classes + node.class as usize],
+            Indices::Tree { factor, suffix } => node.class * factor + suffix[rule],
         };
         Placed {
             placement: Placement {
@@ -217,6 +252,8 @@ pub(crate) struct Listed<'a, S, F> {
     m: usize,
     /// Levels from the listed one to the sampled one.
     depth: u32,
+    /// What the listed tiles' indices are.
+    indexing: Indexing,
     /// The last run's `h` and descent.
     run: Option<(usize, Descent)>,
     place: F,
@@ -224,14 +261,24 @@ pub(crate) struct Listed<'a, S, F> {
 
 impl<'a, S: Subdivision, F> Listed<'a, S, F> {
     /// A source of the level `depth` below the listed one, whose `m` tiles
-    /// of codes `first..first + list.len()` are `list`.
-    pub fn new(sub: &'a S, list: Vec<Node>, first: usize, m: usize, depth: u32, place: F) -> Self {
+    /// of codes `first..first + list.len()` are `list`, their indices
+    /// of kind `indexing`.
+    pub fn new(
+        sub: &'a S,
+        list: Vec<Node>,
+        first: usize,
+        m: usize,
+        depth: u32,
+        indexing: Indexing,
+        place: F,
+    ) -> Self {
         Listed {
             sub,
             list,
             first,
             m,
             depth,
+            indexing,
             run: None,
             place,
         }
@@ -257,7 +304,7 @@ where
                         Some(digit)
                     })
                     .collect();
-                self.run = Some((h, Descent::new(sub, &digits)));
+                self.run = Some((h, Descent::new(sub, &digits, self.indexing)));
             }
             let descent = &self.run.as_ref().expect("set above").1;
             let start = h * self.m + within.start;

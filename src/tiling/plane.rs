@@ -16,7 +16,7 @@
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::polyomino::{Lattice, Orientation, Placement, Shape};
 use crate::sample::Sample;
-use crate::tiling::code_order::{self, CodeOrder, Listed, Node, Subdivision};
+use crate::tiling::code_order::{self, CodeOrder, Indexing, Listed, Node, Subdivision};
 use crate::tiling::{code_value, digit_blocks, mirror_unit, span, Code, TileSystem};
 use glam::DVec2;
 use rayon::prelude::*;
@@ -633,7 +633,15 @@ impl TileSystem for PlaneTiling {
             }
         };
         let depth = level - listed;
-        let source = Listed::new(self, list, listed_codes.start, m, depth, place);
+        let source = Listed::new(
+            self,
+            list,
+            listed_codes.start,
+            m,
+            depth,
+            Indexing::Classes,
+            place,
+        );
         Some(Box::new(source))
     }
 

@@ -16,7 +16,7 @@ use crate::healpix::FacePoint;
 use crate::lut::SphereLut;
 use crate::polyomino::{Lattice, Placement, Shape};
 use crate::sample::Sample;
-use crate::tiling::code_order::{self, CodeOrder, Listed, Node, Subdivision};
+use crate::tiling::code_order::{self, CodeOrder, Indexing, Listed, Node, Subdivision};
 use crate::tiling::{code_value, digit_blocks, span, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -498,8 +498,9 @@ impl TileSystem for SphereTiling {
     }
 
     /// From a list of one level's tiles in code order (see
-    /// [`code_order`]), no shallower than the tree-indexed levels, so that
-    /// the classes descend by the automaton.
+    /// [`code_order`]). A tree-indexed level descends from its list by tree
+    /// index; a deeper one lists no shallower than the level whose classes
+    /// the table holds, so that the classes descend by the automaton.
     fn code_order(
         &self,
         level: u32,
@@ -511,19 +512,18 @@ impl TileSystem for SphereTiling {
             return None;
         }
         let exact = self.lut.exact_levels as u32;
-        // a tree-indexed level lists itself; deeper ones list from the level
-        // whose classes the table holds (`entry_class`), and the automaton
-        // carries them down
-        let first = if level >= exact { exact - 2 } else { exact };
+        let (first, indexing) = match level < exact {
+            true => (0, Indexing::Tree),
+            false => (exact - 2, Indexing::Classes),
+        };
         let listed = code_order::list_level(level, first, |l| self.capacity(l));
         let m = self.capacity(listed) as usize;
         let listed_codes = code_order::listed_codes(&codes, m);
         let mut list = Vec::with_capacity(listed_codes.len());
         self.extend_in_code_order(listed, listed_codes.clone(), &mut list, &|_, t| {
-            let index = if level >= exact {
-                self.class_of(t)
-            } else {
-                t.index
+            let index = match indexing {
+                Indexing::Tree => t.index,
+                Indexing::Classes => self.class_of(t),
             };
             Node::new(&t.placement, t.rule, index, t.face)
         });
@@ -536,7 +536,7 @@ impl TileSystem for SphereTiling {
             position: on_face(t.face, &t.placement, scale, offset).to_vec(),
             rank: code_value(code as Code) / d,
         };
-        if level >= exact {
+        if indexing == Indexing::Classes {
             // each class's offset at this fraction, looked up once
             let offsets: Vec<[f64; 2]> = (0..self.lut.transitions.len())
                 .map(|class| {
@@ -552,25 +552,26 @@ impl TileSystem for SphereTiling {
             let place = move |t: &code_order::Placed, code: usize| {
                 sample(t, code, offsets[t.class as usize])
             };
-            let source = Listed::new(self, list, listed_codes.start, m, depth, place);
+            let source = Listed::new(self, list, listed_codes.start, m, depth, indexing, place);
             return Some(Box::new(source));
         }
         // tiles indexed by tree position: an offset per tile (and its fill),
-        // with the request's bin and fill counts found once
+        // with the request's bin, fill counts and tables found once
         let lut = &*self.lut;
         let capacity = self.capacity(level);
         let bin = lut.bin(fraction, capacity);
         let fills = lut.fill_counts(level, fraction, capacity, bin);
+        let offsets = lut.level_offsets(level as usize, bin, fills.is_some());
         let place = move |t: &code_order::Placed, code: usize| {
-            let (l, index) = (level as usize, t.class as usize);
+            let index = t.class as usize;
             let offset = match fills.and_then(|f| f.pair(code as u64)) {
                 // tree indices: the parent's is the tile's over 4
-                Some(pair) => lut.fill(l, index / 4, pair),
-                None => lut.offset(l, index, bin),
+                Some(pair) => offsets.fill(index / 4, pair),
+                None => offsets.offset(index),
             };
             sample(t, code, offset)
         };
-        let source = Listed::new(self, list, listed_codes.start, m, depth, place);
+        let source = Listed::new(self, list, listed_codes.start, m, depth, indexing, place);
         Some(Box::new(source))
     }
 
