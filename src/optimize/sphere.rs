@@ -74,13 +74,13 @@ pub struct BuildOptions {
     /// Separation steps per table level and bin, after Lloyd.
     pub separation_steps: usize,
     /// Levels, from the first it serves (`exact_levels`) down, on which the
-    /// class table's separation steps measure (it is relaxed one level up,
-    /// on the last tree-indexed level, where that is cheaper).
+    /// class table's separation steps measure, at most 2 (it is relaxed
+    /// on the class levels above, where that is cheaper).
     pub class_separation_depth: u8,
     /// Levels below those on which the classes met only by closing the
     /// automaton get separation steps of their own, each class on the
     /// first of them where it appears (level 8 alone lists 15.7 million
-    /// tiles).
+    /// tiles, level 9 63 million).
     pub closure_levels: u8,
 }
 
@@ -100,7 +100,7 @@ impl Default for BuildOptions {
             deep_tile_iterations: 8,
             separation_steps: 40,
             class_separation_depth: 1,
-            closure_levels: 2,
+            closure_levels: 1,
         }
     }
 }
@@ -148,10 +148,10 @@ pub struct BuildReport {
     pub stage_seconds: Vec<(String, f64)>,
 }
 
-/// First level the class table's separation steps measure on: the first
-/// level it serves, or the deepest enumerated one when a tree-indexed level
-/// lies there too (the class table is relaxed on the levels above it).
-fn class_check(options: &BuildOptions) -> u32 {
+/// First level whose rows start from the class table's offsets: the
+/// deepest enumerated level, or the first the class table serves if that
+/// is shallower (the class table is relaxed on the class levels above).
+fn class_seeded_from(options: &BuildOptions) -> u32 {
     options.exact_levels.min(options.class_depth) as u32
 }
 
@@ -181,14 +181,12 @@ pub fn build(
         || options.class_from >= options.class_depth
         || options.bins < 6
         || options.class_depth > 10
-        || class_check(options) - 1 + options.class_separation_depth as u32
-            > options.class_depth as u32
+        || options.class_separation_depth > 2
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
-             0 < fill_levels <= exact_levels, bins >= 6, 0 < class_separation_depth, \
-             min(exact_levels, class_depth) - 1 + class_separation_depth <= class_depth)"
+             0 < fill_levels <= exact_levels, bins >= 6, 0 < class_separation_depth <= 2)"
         )));
     }
     let mut report = BuildReport::default();
@@ -992,7 +990,7 @@ fn relax(
     let mut tables: Vec<Vec<[i8; 2]>> = Vec::new();
     let exact = options.exact_levels as u32;
     let class_from = options.class_from as u32;
-    let check = class_check(options);
+    let check = class_seeded_from(options);
     let class_levels = class_from..check;
     let total: u64 = (0..exact)
         .map(|l| bins as u64 * 4u64.pow(l) * if class_levels.contains(&l) { 2 } else { 1 })
@@ -1094,8 +1092,25 @@ fn relax(
     }
     let closure: Vec<usize> = (0..classes).filter(|&c| !enumerated[c]).collect();
     report.borrowed_rows = borrow_offsets(&mut table, bins, signatures, &closure, centroid);
-    let deeper = check..=check - 1 + options.class_separation_depth as u32;
-    let levels: Vec<_> = deeper.map(|l| (tiling.tiles(l), class_rows(l))).collect();
+    // each tile's class, enumerated down to `class_depth`, by the automaton
+    // below it (tiles in tree order: tile `t`'s parent is `t / 4`)
+    let class_depth = options.class_depth as u32;
+    let classes_at = |level: u32| {
+        let mut rows = class_rows(level.min(class_depth));
+        for _ in class_depth..level {
+            rows = (0..rows.len() * 4)
+                .map(|t| lut.transitions[rows[t / 4] as usize][t % 4])
+                .collect();
+        }
+        rows
+    };
+    // the levels it serves first: checked on level 6 when level 6 had
+    // classes, it read 2.02 there but 1.65 at N = 10^6 (level 7), whose
+    // polar cap met class contexts level 6 did not; a scratch run of 20
+    // steps on level 7's polar window took 10^6 to 2.00 and 2·10^6 from 1.16
+    // to 1.82
+    let served = exact..exact + options.class_separation_depth as u32;
+    let levels: Vec<_> = served.map(|l| (tiling.tiles(l), classes_at(l))).collect();
     let every_row = vec![true; classes];
     let worst = separate(
         tiling,
@@ -1107,12 +1122,18 @@ fn relax(
     );
     report.lloyd_residual.push(residual);
     report.separation.push(worst);
-    // the closure classes, each on the first level below the check where
-    // it appears, alone (every other row stays): a borrowed offset was
-    // fitted around other neighbours
-    let below = check + options.class_separation_depth as u32;
+    // the closure classes, each on the first level below the checked ones
+    // where it appears, alone (every other row stays): a borrowed offset
+    // was fitted around other neighbours
+    let below = exact + options.class_separation_depth as u32;
     let mut fitted = enumerated;
-    let mut classes_above = class_rows(below - 1);
+    for (_, rows) in &levels {
+        for &class in rows {
+            fitted[class as usize] = true;
+        }
+    }
+    drop(levels);
+    let mut classes_above = classes_at(below - 1);
     for level in below..below + options.closure_levels as u32 {
         let tiles = tiling.tiles(level);
         let classes_here: Vec<u32> = (0..tiles.len())
