@@ -327,8 +327,9 @@ pub(crate) struct FillCounts {
 
 impl FillCounts {
     /// The sibling-fill entry of the tile of code `code` (see
-    /// [`SphereLut::fill_pair`]).
-    pub(crate) fn pair(&self, code: u64) -> Option<usize> {
+    /// [`SphereLut::fill_pair`]); `shares_a_hole` runs only for the one
+    /// orbit a request splits.
+    pub(crate) fn pair(&self, code: u64, shares_a_hole: impl FnOnce(u64) -> bool) -> Option<usize> {
         let FillCounts {
             accepted,
             in_bin,
@@ -345,7 +346,13 @@ impl FillCounts {
         // the lowest sibling the request drops (above this one, which it
         // keeps), if the bin keeps it: `ceil((accepted - parent) / parents)`
         let missing = quarters(accepted - parent + parents - 1);
-        (missing <= 3 && parent + missing * parents < in_bin)
+        let lost = parent + missing * parents;
+        // where the lost child's ring twins (codes equal but for the last
+        // two bits) share its hole, next to a pole, its fills are relaxed
+        // with the whole orbit missing: there a request keeping part of the
+        // orbit (at most one orbit a request) keeps the bin's offsets
+        let whole_orbit = lost & !3 >= accepted;
+        (missing <= 3 && lost < in_bin && (whole_orbit || !shares_a_hole(lost)))
             .then(|| (missing * (missing - 1) / 2 + digit) as usize)
     }
 }
@@ -390,6 +397,18 @@ impl SphereLut {
     /// ```
     pub fn bins(&self) -> usize {
         self.bin_fractions.len()
+    }
+
+    /// Codes the set of bin `bin` holds on a level of `capacity` tiles:
+    /// those below `f_b * capacity`.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// assert_eq!(lut.bin_codes(lut.bins() - 1, 960.0), 960);
+    /// ```
+    pub fn bin_codes(&self, bin: usize, capacity: f64) -> u64 {
+        (self.bin_fractions[bin] * capacity).ceil() as u64
     }
 
     /// Decodes a table, checking its version and internal consistency.
@@ -570,7 +589,10 @@ impl SphereLut {
     /// Which sibling-fill entry a tile of a per-tile level takes at density
     /// `fraction` of its level (capacity `capacity`, importance bin `bin`):
     /// `Some(pair)` when the bin's set has a sibling of higher digit that
-    /// the request drops. `code` is the tile's code: its parent's code
+    /// the request drops; if `shares_a_hole` says that sibling's ring
+    /// twins (the codes equal to its own but for the last two bits) share
+    /// its hole, as next to a pole, only if the request drops them too.
+    /// `code` is the tile's code: its parent's code
     /// plus its digit times the parent level's capacity.
     ///
     /// # Example
@@ -582,9 +604,16 @@ impl SphereLut {
     /// // bin 3 keeps codes below 1401.1, so the parent of code 1350
     /// // (code 1350 - 960 = 390) lacks its digit-1 child; its digit-0
     /// // child, code 390, fills in
-    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity), Some(0));
+    /// let apart = |_| false;
+    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, apart), Some(0));
     /// // the parent of code 291 keeps both children the bin has
-    /// assert_eq!(lut.fill_pair(291, 2, fraction, bin, capacity), None);
+    /// assert_eq!(lut.fill_pair(291, 2, fraction, bin, capacity, apart), None);
+    /// // keeping codes below 1350 keeps 1348 and 1349, twins of code 1350:
+    /// // a fill next to a pole assumed them missing
+    /// let fraction = 1350.0 / capacity;
+    /// let bin = lut.bin(fraction, capacity);
+    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, apart), Some(0));
+    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, |_| true), None);
     /// ```
     pub fn fill_pair(
         &self,
@@ -593,9 +622,10 @@ impl SphereLut {
         fraction: f64,
         bin: usize,
         capacity: f64,
+        shares_a_hole: impl FnOnce(u64) -> bool,
     ) -> Option<usize> {
         let counts = self.fill_counts(level, fraction, capacity, bin)?;
-        counts.pair(code as u64)
+        counts.pair(code as u64, shares_a_hole)
     }
 
     /// What [`Self::fill_pair`] needs of a request, computed once for all
@@ -614,7 +644,7 @@ impl SphereLut {
         Some(FillCounts {
             accepted: accepted_count(fraction, capacity) as u64,
             // the bin's set: codes below `f_b * capacity` (see `bin`)
-            in_bin: (self.bin_fractions[bin] * capacity).ceil() as u64,
+            in_bin: self.bin_codes(bin, capacity),
             parents: capacity as u64 / 4,
         })
     }

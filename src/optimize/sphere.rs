@@ -20,7 +20,10 @@ use crate::healpix::{self, Cell, Dir, FacePoint};
 use crate::lut::{Offsets, SphereLut, FILL_PAIRS, SPHERE_LUT_VERSION};
 use crate::polyomino::exact_cover;
 use crate::polyomino::{Lattice, Orientation, Placement, Rule, Shape};
-use crate::tiling::sphere::{SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT};
+use crate::tiling::sphere::{
+    twins_share_a_hole, SphereTile, SphereTiling, PATCH_SIDE, ROOTS_PER_FACE, ROOT_COUNT,
+    TWINS_SHARE_A_HOLE,
+};
 use crate::tiling::{Code, TileSystem};
 use crate::Error;
 use glam::DVec3;
@@ -77,8 +80,8 @@ pub struct BuildOptions {
     /// class table's separation steps measure, at most 2 (it is relaxed
     /// on the class levels above, where that is cheaper).
     pub class_separation_depth: u8,
-    /// Levels below those on which the classes met only by closing the
-    /// automaton get separation steps of their own, each class on the
+    /// Levels below those on which the classes the checked levels do not
+    /// hold get separation steps of their own, each class on the
     /// first of them where it appears (level 8 alone lists 15.7 million
     /// tiles, level 9 63 million).
     pub closure_levels: u8,
@@ -137,8 +140,8 @@ pub struct BuildReport {
     /// Worst separation (`sqrt(n)` times the smallest distance) over the
     /// bins of each table, before and after the separation steps.
     pub separation: Vec<(f64, f64)>,
-    /// Per level below the class table's check: the closure classes first
-    /// met there, and the worst separation of their points before and
+    /// Per level below the class table's check: the classes first met
+    /// there, and the worst separation of their points before and
     /// after separation steps that move only their rows.
     pub closure_separation: Vec<(usize, (f64, f64))>,
     /// Wall time of the Lloyd relaxation and separation steps of each
@@ -1122,11 +1125,14 @@ fn relax(
     );
     report.lloyd_residual.push(residual);
     report.separation.push(worst);
-    // the closure classes, each on the first level below the checked ones
-    // where it appears, alone (every other row stays): a borrowed offset
-    // was fitted around other neighbours
+    // the classes the checked levels do not hold, each on the first level
+    // below them where it appears, alone (every other row stays): a borrowed
+    // offset was fitted around other neighbours, and an enumerated class
+    // absent from the checked levels was relaxed only on levels 4-5, where
+    // per-tile rows now serve (469 of level 8's 818 new classes; left
+    // fixed, one of them met a level-7 class at 1.19 / sqrt(N), N = 5·10^6)
     let below = exact + options.class_separation_depth as u32;
-    let mut fitted = enumerated;
+    let mut fitted = vec![false; classes];
     for (_, rows) in &levels {
         for &class in rows {
             fitted[class as usize] = true;
@@ -1549,10 +1555,11 @@ const FILL_GUARD: f64 = 0.75;
 /// The sibling fills of one bin that keep every pair of points a request
 /// may hold at least [`FILL_GUARD`] spacings apart: each problem (the
 /// siblings of one missing code, `below + 1 + k` for `problems[k]`)
-/// whole or not at all, in code order, against the bin's points (its own
-/// missing child and siblings aside) and the fills already kept.
+/// whole or not at all, in code order, against the bin's points (the
+/// children of its `families` aside: its missing orbit and their
+/// siblings) and the fills already kept.
 fn guard_separation(
-    problems: &[Vec<Fill>],
+    problems: &[FillProblem],
     sites: &[DVec3],
     below: usize,
     parents: usize,
@@ -1564,8 +1571,9 @@ fn guard_separation(
     let mut entries = Vec::new();
     for (k, problem) in problems.iter().enumerate() {
         let missing = below + 1 + k;
-        let family = |c: usize| c % parents == missing % parents;
-        let clear = problem.iter().all(|fill| {
+        let family = |c: usize| problem.families.contains(&(c % parents));
+        let fills = &problem.fills;
+        let clear = fills.iter().all(|fill| {
             let p = fill.placed;
             let near =
                 tree.within_unsorted::<SquaredEuclidean>(&(skew() * p).to_array(), guard * guard);
@@ -1573,17 +1581,17 @@ fn guard_separation(
                 && kept
                     .iter()
                     .all(|&(c, q)| family(c) || p.distance(q) >= guard)
-        }) && problem.iter().enumerate().all(|(i, a)| {
-            problem[i + 1..]
+        }) && fills.iter().enumerate().all(|(i, a)| {
+            fills[i + 1..]
                 .iter()
                 .all(|b| a.placed.distance(b.placed) >= guard)
         });
         if clear {
-            kept.extend(problem.iter().map(|fill| (missing, fill.placed)));
+            kept.extend(fills.iter().map(|fill| (missing, fill.placed)));
         }
         // a problem left out keeps its siblings where the bin has them
         entries.extend(
-            problem
+            fills
                 .iter()
                 .map(|fill| (fill.row, if clear { fill.stored } else { fill.unmoved })),
         );
@@ -1598,6 +1606,15 @@ struct Fill {
     stored: [i8; 2],
     placed: DVec3,
     unmoved: [i8; 2],
+}
+
+/// The sibling fills of one missing code, and the parents (its own and
+/// its orbit twins' that share its hole) whose children a request reading
+/// them never holds where the bin has them.
+#[derive(Default)]
+struct FillProblem {
+    fills: Vec<Fill>,
+    families: Vec<usize>,
 }
 
 /// A fixed generic rotation: the tiling's symmetries give many sites equal
@@ -1617,8 +1634,9 @@ fn site_tree(sites: &[DVec3]) -> ImmutableKdTree<f64, u32, 3, 32> {
 /// Lloyd iterations of each sibling-fill problem.
 const FILL_ITERATIONS: usize = 10;
 /// Radius, in point spacings, about the missing point and each sibling,
-/// of the neighbourhood a sibling-fill problem relaxes in.
-const FILL_RADIUS: f64 = 3.5;
+/// of the neighbourhood a sibling-fill problem relaxes in; ring twins
+/// within it share the missing point's hole.
+const FILL_RADIUS: f64 = TWINS_SHARE_A_HOLE;
 
 /// The sibling-fill tables (see [`SphereLut::fills`]). For each bin of a
 /// per-tile level and each code of the bin's set that a request using the
@@ -1658,20 +1676,47 @@ fn sibling_fills(
             let radius2 = (FILL_RADIUS * spacing).powi(2);
             // each missing code's problem: its siblings' rows, stored
             // offsets and the points those offsets give
-            let problems: Vec<Vec<Fill>> = (below + 1..in_bin)
+            let problems: Vec<FillProblem> = (below + 1..in_bin)
                 .into_par_iter()
                 .map(|missing| {
                     if ring && by_code[missing].face % 4 != 0 {
-                        return Vec::new();
+                        return FillProblem::default();
                     }
-                    let (digit, parent) = (missing / parents, missing % parents);
-                    let siblings: Vec<usize> = (0..digit).map(|j| parent + j * parents).collect();
-                    // the neighbours of the missing site and of each sibling:
+                    let digit = missing / parents;
+                    let siblings_of = |c: usize| (0..digit).map(move |j| c % parents + j * parents);
+                    let siblings: Vec<usize> = siblings_of(missing).collect();
+                    // its ring orbit (codes equal but for the last two bits):
+                    // where the twins share its hole, at a pole, the four lie
+                    // about one spacing apart, and a problem holding the
+                    // other three in place moved the siblings little (the
+                    // pole's hole read 4.3-4.7 / sqrt(N), N = 1661, 112,421);
+                    // the fill then assumes the whole orbit missing, and the
+                    // run time makes the same test before reading it for a
+                    // request that keeps part of the orbit
+                    let first = missing & !3;
+                    let orbit: Vec<usize> = (first..first + 4).filter(|&c| c < in_bin).collect();
+                    let hole = (level, bin, in_bin as u64);
+                    // the codes missing whenever the fill is read
+                    let gone = match twins_share_a_hole(tiling, lut, hole, missing as u64) {
+                        // a request of this bin keeps codes up to `below`,
+                        // so never the whole orbit: no fill is read
+                        true if first <= below => return FillProblem::default(),
+                        true => orbit,
+                        false => vec![missing],
+                    };
+                    // those sharing its hole, whose siblings move with its own
+                    let joint: Vec<usize> = gone
+                        .iter()
+                        .copied()
+                        .filter(|&c| sites[c].distance(sites[missing]) < FILL_RADIUS * spacing)
+                        .collect();
+                    let moved: Vec<usize> = joint.iter().flat_map(|&c| siblings_of(c)).collect();
+                    // the neighbours of the missing sites and of each sibling:
                     // near the polar caps' corners siblings lie up to 3.5
                     // spacings apart, so a radius about the missing site
                     // alone left a sibling out, unmoved while the others
                     // closed in on it (0.78 / sqrt(N) at N = 731,824)
-                    let mut local: Vec<usize> = (siblings.iter().chain([&missing]))
+                    let mut local: Vec<usize> = (moved.iter().chain(&joint))
                         .flat_map(|&f| {
                             tree.within_unsorted::<SquaredEuclidean>(
                                 &(skew() * sites[f]).to_array(),
@@ -1679,16 +1724,16 @@ fn sibling_fills(
                             )
                         })
                         .map(|n| n.item as usize)
-                        .filter(|&c| c != missing)
+                        .filter(|c| !gone.contains(c))
                         .collect();
                     local.sort_unstable();
                     local.dedup();
                     let mut points: Vec<DVec3> = local.iter().map(|&c| sites[c]).collect();
                     let movable: Vec<usize> = (0..local.len())
-                        .filter(|&k| siblings.contains(&local[k]))
+                        .filter(|&k| moved.contains(&local[k]))
                         .collect();
                     crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS);
-                    local
+                    let fills = local
                         .iter()
                         .zip(points)
                         .filter(|(c, _)| siblings.contains(c))
@@ -1713,7 +1758,9 @@ fn sibling_fills(
                                 unmoved,
                             }
                         })
-                        .collect()
+                        .collect();
+                    let families = joint.iter().map(|&c| c % parents).collect();
+                    FillProblem { fills, families }
                 })
                 .collect();
             let entries = guard_separation(&problems, &sites, below, parents, spacing);

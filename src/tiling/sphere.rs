@@ -348,7 +348,9 @@ impl SphereTiling {
         let lut = &*self.lut;
         let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
         let bin = lut.bin(fraction, capacity);
-        match lut.fill_pair(tile.code, level, fraction, bin, capacity) {
+        let hole = (level, bin, lut.bin_codes(bin, capacity));
+        let shares = |lost| twins_share_a_hole(self, lut, hole, lost);
+        match lut.fill_pair(tile.code, level, fraction, bin, capacity, shares) {
             // tree indices: the parent's is the tile's over 4
             Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
             None => lut.offset(level as usize, tile.index as usize, bin),
@@ -365,6 +367,38 @@ impl SphereTiling {
     pub fn shape(&self) -> &Shape {
         &self.shape
     }
+}
+
+/// Spacings (of a bin's set) within which a tile's ring twins, the tiles
+/// whose codes differ from its own in the last two bits only, share the
+/// hole it leaves: the four tiles next to a pole, about one spacing apart.
+/// The builder relaxes the sibling fills of such a tile with its whole
+/// orbit missing, and a request that keeps part of the orbit reads none.
+pub(crate) const TWINS_SHARE_A_HOLE: f64 = 3.5;
+
+/// Whether a ring twin of the tile of code `lost` on tree-indexed level
+/// `level` lies within [`TWINS_SHARE_A_HOLE`] spacings of it, their points
+/// placed by `lut`'s offsets in bin `bin`, whose set holds `in_bin` codes
+/// (twins outside it do not count).
+pub(crate) fn twins_share_a_hole(
+    tiling: &SphereTiling,
+    lut: &SphereLut,
+    (level, bin, in_bin): (u32, usize, u64),
+    lost: u64,
+) -> bool {
+    let site = |code: u64| {
+        let tile = tiling.tile_with_code(level, code as Code)?;
+        let offset = lut.offset(level as usize, tile.index as usize, bin);
+        Some(tiling.face_point(&tile, offset).to_vec())
+    };
+    let Some(own) = site(lost) else {
+        return false;
+    };
+    let spacing = (4.0 * std::f64::consts::PI / in_bin as f64).sqrt();
+    (lost & !3..(lost | 3) + 1)
+        .filter(|&twin| twin != lost && twin < in_bin)
+        .filter_map(site)
+        .any(|twin| twin.distance(own) < TWINS_SHARE_A_HOLE * spacing)
 }
 
 /// The face point of a point given in the frame (cells) of a tile so
@@ -562,9 +596,11 @@ impl TileSystem for SphereTiling {
         let bin = lut.bin(fraction, capacity);
         let fills = lut.fill_counts(level, fraction, capacity, bin);
         let offsets = lut.level_offsets(level as usize, bin, fills.is_some());
+        let hole = (level, bin, lut.bin_codes(bin, capacity));
         let place = move |t: &code_order::Placed, code: usize| {
             let index = t.class as usize;
-            let offset = match fills.and_then(|f| f.pair(code as u64)) {
+            let shares = |lost| twins_share_a_hole(self, lut, hole, lost);
+            let offset = match fills.and_then(|f| f.pair(code as u64, shares)) {
                 // tree indices: the parent's is the tile's over 4
                 Some(pair) => offsets.fill(index / 4, pair),
                 None => offsets.offset(index),
