@@ -1665,8 +1665,8 @@ fn sibling_fills(
         let ring = rows < parents;
         let mut table = vec![unused; rows * FILL_PAIRS];
         for bin in 1..lut.bins() {
-            let in_bin = (lut.bin_fractions[bin] * capacity).ceil() as usize;
-            let below = (lut.bin_fractions[bin - 1] * capacity).ceil() as usize;
+            let in_bin = lut.bin_codes(bin, capacity) as usize;
+            let below = lut.bin_codes(bin - 1, capacity) as usize;
             let offset = |c: usize| lut.offset(level as usize, by_code[c].index as usize, bin);
             let sites: Vec<DVec3> = (0..in_bin)
                 .map(|c| tiling.face_point(&by_code[c], offset(c)).to_vec())
@@ -1695,9 +1695,8 @@ fn sibling_fills(
                     // request that keeps part of the orbit
                     let first = missing & !3;
                     let orbit: Vec<usize> = (first..first + 4).filter(|&c| c < in_bin).collect();
-                    let hole = (level, bin, in_bin as u64);
                     // the codes missing whenever the fill is read
-                    let gone = match twins_share_a_hole(tiling, lut, hole, missing as u64) {
+                    let gone = match twins_share_a_hole(tiling, lut, (level, bin), missing as u64) {
                         // a request of this bin keeps codes up to `below`,
                         // so never the whole orbit: no fill is read
                         true if first <= below => return FillProblem::default(),

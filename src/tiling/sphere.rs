@@ -348,8 +348,7 @@ impl SphereTiling {
         let lut = &*self.lut;
         let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
         let bin = lut.bin(fraction, capacity);
-        let hole = (level, bin, lut.bin_codes(bin, capacity));
-        let shares = |lost| twins_share_a_hole(self, lut, hole, lost);
+        let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
         match lut.fill_pair(tile.code, level, fraction, bin, capacity, shares) {
             // tree indices: the parent's is the tile's over 4
             Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
@@ -378,14 +377,15 @@ pub(crate) const TWINS_SHARE_A_HOLE: f64 = 3.5;
 
 /// Whether a ring twin of the tile of code `lost` on tree-indexed level
 /// `level` lies within [`TWINS_SHARE_A_HOLE`] spacings of it, their points
-/// placed by `lut`'s offsets in bin `bin`, whose set holds `in_bin` codes
-/// (twins outside it do not count).
+/// placed by `lut`'s offsets in bin `bin` (twins outside the bin's set do
+/// not count).
 pub(crate) fn twins_share_a_hole(
     tiling: &SphereTiling,
     lut: &SphereLut,
-    (level, bin, in_bin): (u32, usize, u64),
+    (level, bin): (u32, usize),
     lost: u64,
 ) -> bool {
+    let in_bin = lut.bin_codes(bin, tiling.capacity(level));
     let site = |code: u64| {
         let tile = tiling.tile_with_code(level, code as Code)?;
         let offset = lut.offset(level as usize, tile.index as usize, bin);
@@ -596,10 +596,9 @@ impl TileSystem for SphereTiling {
         let bin = lut.bin(fraction, capacity);
         let fills = lut.fill_counts(level, fraction, capacity, bin);
         let offsets = lut.level_offsets(level as usize, bin, fills.is_some());
-        let hole = (level, bin, lut.bin_codes(bin, capacity));
         let place = move |t: &code_order::Placed, code: usize| {
             let index = t.class as usize;
-            let shares = |lost| twins_share_a_hole(self, lut, hole, lost);
+            let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
             let offset = match fills.and_then(|f| f.pair(code as u64, shares)) {
                 // tree indices: the parent's is the tile's over 4
                 Some(pair) => offsets.fill(index / 4, pair),
