@@ -252,7 +252,8 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
     // covering mean 3.95 and worst 5.17, mesh ratio worst 3.81. Format 5's
     // orbit root ranks moved the holes: mean 3.49, worst 4.56 (N = 1644);
     // the builder's seam fix (rows past a face edge move) 3.47 and 4.62;
-    // fills relaxed with a pole's whole ring orbit missing 3.46 and 4.62
+    // fills relaxed with a pole's whole ring orbit missing 3.46 and 4.62;
+    // fills solved in the order requests read them 3.39 and 4.62
     use tessera::metrics::sphere::{covering_radius, separation};
     let (mut coverings, mut worst_mesh) = (Vec::new(), 0.0f64);
     for n in (965..3840).step_by(97) {
@@ -265,10 +266,26 @@ fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
     let mean = coverings.iter().sum::<f64>() / coverings.len() as f64;
     let worst = coverings.iter().cloned().fold(0.0, f64::max);
     assert!(
-        mean <= 3.6 && worst <= 4.65,
+        mean <= 3.42 && worst <= 4.65,
         "covering mean {mean:.3}, worst {worst:.3}"
     );
     assert!(worst_mesh <= 3.4, "mesh ratio worst {worst_mesh:.3}");
+}
+
+#[test]
+fn neighbouring_holes_between_bins_close_together() {
+    // most holes wider than 3.4 / sqrt(N) between bins were two adjacent
+    // dropped tiles; fills relaxed each with the rest of the bin's set in
+    // place left them open: covering 3.69 (N = 4238), 3.73 (10,812), 3.83
+    // (37,694). Solved in the order requests read them, each with the
+    // higher codes' fills in place: 3.28, 3.53, 3.48
+    use tessera::metrics::sphere::{covering_radius, separation};
+    for n in [4238, 10_812, 37_694] {
+        let points = uniform_points(n);
+        let (covering, spacing) = (covering_radius(&points), separation(&points));
+        assert!(covering <= 3.6, "N = {n}: covering {covering:.3}");
+        assert!(spacing >= 2.5, "N = {n}: separation {spacing:.3}");
+    }
 }
 
 #[test]

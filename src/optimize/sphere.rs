@@ -1552,69 +1552,35 @@ fn closure_window(
 /// separation floor of 2.4 / sqrt(N) and the bin's own 2.6-3.0.
 const FILL_GUARD: f64 = 0.75;
 
-/// The sibling fills of one bin that keep every pair of points a request
-/// may hold at least [`FILL_GUARD`] spacings apart: each problem (the
-/// siblings of one missing code, `below + 1 + k` for `problems[k]`)
-/// whole or not at all, in code order, against the bin's points (the
-/// children of its `families` aside: its missing orbit and their
-/// siblings) and the fills already kept.
-fn guard_separation(
-    problems: &[FillProblem],
-    sites: &[DVec3],
-    below: usize,
-    parents: usize,
-    spacing: f64,
-) -> Vec<(usize, [i8; 2])> {
-    let guard = FILL_GUARD * spacing;
-    let tree = site_tree(sites);
-    let mut kept: Vec<(usize, DVec3)> = Vec::new();
-    let mut entries = Vec::new();
-    for (k, problem) in problems.iter().enumerate() {
-        let missing = below + 1 + k;
-        let family = |c: usize| problem.families.contains(&(c % parents));
-        let fills = &problem.fills;
-        let clear = fills.iter().all(|fill| {
-            let p = fill.placed;
-            let near =
-                tree.within_unsorted::<SquaredEuclidean>(&(skew() * p).to_array(), guard * guard);
-            near.iter().all(|n| family(n.item as usize))
-                && kept
-                    .iter()
-                    .all(|&(c, q)| family(c) || p.distance(q) >= guard)
-        }) && fills.iter().enumerate().all(|(i, a)| {
-            fills[i + 1..]
-                .iter()
-                .all(|b| a.placed.distance(b.placed) >= guard)
-        });
-        if clear {
-            kept.extend(fills.iter().map(|fill| (missing, fill.placed)));
-        }
-        // a problem left out keeps its siblings where the bin has them
-        entries.extend(
-            fills
-                .iter()
-                .map(|fill| (fill.row, if clear { fill.stored } else { fill.unmoved })),
-        );
-    }
-    entries
-}
-
-/// One sibling's fill: its row in the fill table, the stored offset, the
-/// point it gives, and the bin's own offset for the tile.
+/// One sibling's fill: its code and row in the fill table, the stored
+/// offset, the point it gives, and the bin's own offset for the tile.
+#[derive(Clone, Copy)]
 struct Fill {
+    code: usize,
     row: usize,
     stored: [i8; 2],
     placed: DVec3,
     unmoved: [i8; 2],
 }
 
-/// The sibling fills of one missing code, and the parents (its own and
-/// its orbit twins' that share its hole) whose children a request reading
-/// them never holds where the bin has them.
-#[derive(Default)]
+/// The sibling fills of one missing code.
 struct FillProblem {
-    fills: Vec<Fill>,
-    families: Vec<usize>,
+    /// The request keeping the codes below this one is the first to read
+    /// the fills: the missing code, or its orbit's first where the ring
+    /// twins share its hole.
+    threshold: usize,
+    missing: usize,
+    /// Whether its fills assume its whole ring orbit missing.
+    orbit: bool,
+    /// The missing codes sharing its hole, the points the requests
+    /// reading it hold about them, and those it moves (the siblings of the
+    /// missing codes).
+    joint: Vec<usize>,
+    local: Vec<usize>,
+    moved: Vec<usize>,
+    /// Its siblings relaxed among the points those requests hold, and
+    /// among the bin's set with only its hole missing.
+    candidates: [Vec<Fill>; 2],
 }
 
 /// A fixed generic rotation: the tiling's symmetries give many sites equal
@@ -1637,140 +1603,405 @@ const FILL_ITERATIONS: usize = 10;
 /// of the neighbourhood a sibling-fill problem relaxes in; ring twins
 /// within it share the missing point's hole.
 const FILL_RADIUS: f64 = TWINS_SHARE_A_HOLE;
+/// Sibling-fill problems solved at once from one state of the bin's
+/// points. Consecutive codes lie far apart, so few problems of a batch
+/// meet; one that saw a point an earlier one moved is solved again.
+const FILL_BATCH: usize = 64;
+/// Spacings about a missing point within which [`BinFills::hole`] probes.
+const HOLE_PROBES: f64 = 1.5;
 
-/// The sibling-fill tables (see [`SphereLut::fills`]). For each bin of a
-/// per-tile level and each code of the bin's set that a request using the
-/// bin may drop, the dropped tile's lower siblings are relaxed with it
-/// missing and every other point of the bin's set held in place. Each
-/// parent alone: in a request, the parents around it may keep all their
-/// children, and siblings relaxed together with a neighbour's hole would
-/// crowd that neighbour's child when it is kept.
+/// The sibling-fill tables (see [`SphereLut::fills`]), a level and a bin
+/// at a time (see [`BinFills`]).
 fn sibling_fills(
     tiling: &SphereTiling,
     lut: &SphereLut,
     fill_levels: u32,
     progress: Progress,
 ) -> Vec<Vec<[i8; 2]>> {
-    let room = tiling.shape().dilated();
     let unused = SphereLut::quantise(tiling.shape().centroid());
     let mut fills = vec![Vec::new()];
     for level in 1..fill_levels {
-        let capacity = tiling.capacity(level);
-        let parents = capacity as usize / 4;
         let mut by_code = tiling.tiles(level);
         by_code.sort_unstable_by_key(|t| t.code);
-        // parents' rows: at ring levels a ring's first face relaxes the
-        // fills its three twins share
-        let rows = lut.rows(level as usize - 1);
-        let ring = rows < parents;
-        let mut table = vec![unused; rows * FILL_PAIRS];
+        let mut table = vec![unused; lut.rows(level as usize - 1) * FILL_PAIRS];
         for bin in 1..lut.bins() {
-            let in_bin = lut.bin_codes(bin, capacity) as usize;
-            let below = lut.bin_codes(bin - 1, capacity) as usize;
-            let offset = |c: usize| lut.offset(level as usize, by_code[c].index as usize, bin);
-            let sites: Vec<DVec3> = (0..in_bin)
-                .map(|c| tiling.face_point(&by_code[c], offset(c)).to_vec())
-                .collect();
-            let tree = site_tree(&sites);
-            let spacing = (4.0 * std::f64::consts::PI / in_bin as f64).sqrt();
-            let radius2 = (FILL_RADIUS * spacing).powi(2);
-            // each missing code's problem: its siblings' rows, stored
-            // offsets and the points those offsets give
-            let problems: Vec<FillProblem> = (below + 1..in_bin)
-                .into_par_iter()
-                .map(|missing| {
-                    if ring && by_code[missing].face % 4 != 0 {
-                        return FillProblem::default();
-                    }
-                    let digit = missing / parents;
-                    let siblings_of = |c: usize| (0..digit).map(move |j| c % parents + j * parents);
-                    let siblings: Vec<usize> = siblings_of(missing).collect();
-                    // its ring orbit (codes equal but for the last two bits):
-                    // where the twins share its hole, at a pole, the four lie
-                    // about one spacing apart, and a problem holding the
-                    // other three in place moved the siblings little (the
-                    // pole's hole read 4.3-4.7 / sqrt(N), N = 1661, 112,421);
-                    // the fill then assumes the whole orbit missing, and the
-                    // run time makes the same test before reading it for a
-                    // request that keeps part of the orbit
-                    let first = missing & !3;
-                    let orbit: Vec<usize> = (first..first + 4).filter(|&c| c < in_bin).collect();
-                    // the codes missing whenever the fill is read
-                    let gone = match twins_share_a_hole(tiling, lut, (level, bin), missing as u64) {
-                        // a request of this bin keeps codes up to `below`,
-                        // so never the whole orbit: no fill is read
-                        true if first <= below => return FillProblem::default(),
-                        true => orbit,
-                        false => vec![missing],
-                    };
-                    // those sharing its hole, whose siblings move with its own
-                    let joint: Vec<usize> = gone
-                        .iter()
-                        .copied()
-                        .filter(|&c| sites[c].distance(sites[missing]) < FILL_RADIUS * spacing)
-                        .collect();
-                    let moved: Vec<usize> = joint.iter().flat_map(|&c| siblings_of(c)).collect();
-                    // the neighbours of the missing sites and of each sibling:
-                    // near the polar caps' corners siblings lie up to 3.5
-                    // spacings apart, so a radius about the missing site
-                    // alone left a sibling out, unmoved while the others
-                    // closed in on it (0.78 / sqrt(N) at N = 731,824)
-                    let mut local: Vec<usize> = (moved.iter().chain(&joint))
-                        .flat_map(|&f| {
-                            tree.within_unsorted::<SquaredEuclidean>(
-                                &(skew() * sites[f]).to_array(),
-                                radius2,
-                            )
-                        })
-                        .map(|n| n.item as usize)
-                        .filter(|c| !gone.contains(c))
-                        .collect();
-                    local.sort_unstable();
-                    local.dedup();
-                    let mut points: Vec<DVec3> = local.iter().map(|&c| sites[c]).collect();
-                    let movable: Vec<usize> = (0..local.len())
-                        .filter(|&k| moved.contains(&local[k]))
-                        .collect();
-                    crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS);
-                    let fills = local
-                        .iter()
-                        .zip(points)
-                        .filter(|(c, _)| siblings.contains(c))
-                        .map(|(&c, target)| {
-                            let tile = &by_code[c];
-                            let mut current = offset(c);
-                            for _ in 0..3 {
-                                let site = tiling.face_point(tile, current).to_vec();
-                                current = to_local(tiling, tile, current, site, target);
-                            }
-                            let stored = SphereLut::quantise(room.clamp(current, 0.02));
-                            let pair = digit * (digit - 1) / 2 + c / parents;
-                            let parent = lut.row(level as usize - 1, tile.index as usize / 4);
-                            let row = parent * FILL_PAIRS + pair;
-                            let placed = tiling.face_point(tile, crate::lut::dequantise(stored));
-                            let own = lut.row(level as usize, tile.index as usize);
-                            let unmoved = lut.tables[level as usize][bin][own];
-                            Fill {
-                                row,
-                                stored,
-                                placed: placed.to_vec(),
-                                unmoved,
-                            }
-                        })
-                        .collect();
-                    let families = joint.iter().map(|&c| c % parents).collect();
-                    FillProblem { fills, families }
-                })
-                .collect();
-            let entries = guard_separation(&problems, &sites, below, parents, spacing);
-            for (row, o) in entries {
-                table[row] = o;
+            for (row, offset) in BinFills::new(tiling, lut, &by_code, bin).solve() {
+                table[row] = offset;
             }
         }
         progress("sibling fills", level as u64, fill_levels as u64 - 1);
         fills.push(table);
     }
     fills
+}
+
+/// One bin's sibling fills on one per-tile level, solved in the order
+/// requests come to read them. A request keeping the codes below `t`
+/// reads the fills of every code from `t` up to the bin's count, so the
+/// highest code's fill is solved first, with the rest of the bin's set in
+/// place, and each lower one with the higher ones' fills in place and
+/// their codes missing. Relaxed only each parent alone, with the rest of
+/// the bin's set in place, two neighbouring holes (most holes wider than
+/// 3.4 / sqrt(N) between bins) stayed open; that relaxation stays a
+/// candidate (see [`BinFills::chosen`]).
+struct BinFills<'a> {
+    tiling: &'a SphereTiling,
+    lut: &'a SphereLut,
+    by_code: &'a [SphereTile],
+    level: u32,
+    bin: usize,
+    parents: usize,
+    /// Whether a ring's first face relaxes the fills its three twins share.
+    ring: bool,
+    /// Codes every request of the bin keeps, and the bin's codes.
+    below: usize,
+    in_bin: usize,
+    spacing: f64,
+    /// The bin's points, and a k-d tree of them to find neighbours by.
+    sites: Vec<DVec3>,
+    tree: ImmutableKdTree<f64, u32, 3, 32>,
+    /// Each point where the requests reading the fills solved so far
+    /// hold it, and the farthest any has moved from its site.
+    current: Vec<DVec3>,
+    farthest: f64,
+}
+
+impl<'a> BinFills<'a> {
+    fn new(
+        tiling: &'a SphereTiling,
+        lut: &'a SphereLut,
+        by_code: &'a [SphereTile],
+        bin: usize,
+    ) -> Self {
+        let level = by_code[0].level as u32;
+        let capacity = tiling.capacity(level);
+        let parents = capacity as usize / 4;
+        let in_bin = lut.bin_codes(bin, capacity) as usize;
+        let sites: Vec<DVec3> = by_code[..in_bin]
+            .par_iter()
+            .map(|t| {
+                let offset = lut.offset(level as usize, t.index as usize, bin);
+                tiling.face_point(t, offset).to_vec()
+            })
+            .collect();
+        BinFills {
+            tiling,
+            lut,
+            by_code,
+            level,
+            bin,
+            parents,
+            ring: lut.rows(level as usize - 1) < parents,
+            below: lut.bin_codes(bin - 1, capacity) as usize,
+            in_bin,
+            spacing: (4.0 * std::f64::consts::PI / in_bin as f64).sqrt(),
+            tree: site_tree(&sites),
+            current: sites.clone(),
+            sites,
+            farthest: 0.0,
+        }
+    }
+
+    /// The fill table's entries: each row and its offset.
+    fn solve(mut self) -> Vec<(usize, [i8; 2])> {
+        let mut order: Vec<(usize, usize, bool)> = (self.below + 1..self.in_bin)
+            .into_par_iter()
+            .filter_map(|missing| {
+                let (threshold, orbit) = self.threshold(missing)?;
+                Some((threshold, missing, orbit))
+            })
+            .collect();
+        order.sort_unstable_by(|a, b| b.cmp(a));
+        let mut entries = Vec::new();
+        // the batch in which a fill last moved each point
+        let mut moved_in = vec![usize::MAX; self.in_bin];
+        // batches of at least FILL_BATCH problems, an orbit's never split
+        let mut batches: Vec<&[(usize, usize, bool)]> = Vec::new();
+        let mut rest = &order[..];
+        while !rest.is_empty() {
+            let mut end = FILL_BATCH.min(rest.len());
+            while end < rest.len() && rest[end].0 == rest[end - 1].0 {
+                end += 1;
+            }
+            let (batch, tail) = rest.split_at(end);
+            batches.push(batch);
+            rest = tail;
+        }
+        for (batch, problems) in batches.into_iter().enumerate() {
+            let solved: Vec<FillProblem> = problems
+                .par_iter()
+                .map(|&(threshold, missing, orbit)| self.problem(threshold, missing, orbit))
+                .collect();
+            // an orbit sharing one hole (problems of one threshold) is
+            // solved from one state; one that saw a point an earlier
+            // problem of the batch moved is solved again
+            let mut solved = solved.into_iter().peekable();
+            while let Some(first) = solved.next() {
+                let threshold = first.threshold;
+                let mut group = vec![first];
+                while let Some(next) = solved.next_if(|p| p.threshold == threshold) {
+                    group.push(next);
+                }
+                let stale = |p: &FillProblem| p.local.iter().any(|&c| moved_in[c] == batch);
+                if group.iter().any(stale) {
+                    group = (group.iter())
+                        .map(|p| self.problem(p.threshold, p.missing, p.orbit))
+                        .collect();
+                }
+                for problem in group {
+                    let fills = self.chosen(&problem);
+                    entries.extend(fills.iter().map(|fill| (fill.row, fill.stored)));
+                    for code in self.place(&problem, &fills) {
+                        moved_in[code] = batch;
+                    }
+                }
+            }
+        }
+        entries
+    }
+
+    /// The code below which a request first reads the fills of `missing`'s
+    /// siblings, if any request of the bin does, and whether they assume
+    /// its whole ring orbit missing.
+    fn threshold(&self, missing: usize) -> Option<(usize, bool)> {
+        if self.ring && self.by_code[missing].face % 4 != 0 {
+            return None;
+        }
+        // its ring orbit (codes equal but for the last two bits): where
+        // the twins share its hole, at a pole, the four lie about one
+        // spacing apart, and a problem holding the other three in place
+        // moved the siblings little (the pole's hole read 4.3-4.7 /
+        // sqrt(N), N = 1661, 112,421); the fill then assumes the whole
+        // orbit missing, and the run time makes the same test before
+        // reading it for a request that keeps part of the orbit
+        let first = missing & !3;
+        let bin = (self.level, self.bin);
+        match twins_share_a_hole(self.tiling, self.lut, bin, missing as u64) {
+            // a request of this bin keeps codes up to `below`, so never
+            // the whole orbit: no fill is read
+            true if first <= self.below => None,
+            true => Some((first, true)),
+            false => Some((missing, false)),
+        }
+    }
+
+    /// The sibling fills of `missing` for the requests keeping the codes
+    /// below `threshold`, relaxed among the points they hold; with `orbit`,
+    /// the ring twins sharing its hole move their siblings too.
+    fn problem(&self, threshold: usize, missing: usize, orbit: bool) -> FillProblem {
+        let (sites, parents) = (&self.sites, self.parents);
+        let digit = missing / parents;
+        let siblings_of = move |c: usize| (0..digit).map(move |j| c % parents + j * parents);
+        // the missing codes sharing its hole, whose siblings move with its own
+        let joint: Vec<usize> = (missing & !3..(missing | 3) + 1)
+            .filter(|&c| c == missing || (orbit && c < self.in_bin))
+            .filter(|&c| sites[c].distance(sites[missing]) < FILL_RADIUS * self.spacing)
+            .collect();
+        let moved: Vec<usize> = joint.iter().flat_map(|&c| siblings_of(c)).collect();
+        // the neighbours of the missing sites and of each sibling: near
+        // the polar caps' corners siblings lie up to 3.5 spacings apart,
+        // so a radius about the missing site alone left a sibling out,
+        // unmoved while the others closed in on it (0.78 / sqrt(N) at
+        // N = 731,824)
+        let radius2 = (FILL_RADIUS * self.spacing).powi(2);
+        let mut near: Vec<usize> = (moved.iter().chain(&joint))
+            .flat_map(|&f| {
+                let at = (skew() * sites[f]).to_array();
+                self.tree.within_unsorted::<SquaredEuclidean>(&at, radius2)
+            })
+            .map(|n| n.item as usize)
+            .collect();
+        near.sort_unstable();
+        near.dedup();
+        let local: Vec<usize> = near.iter().copied().filter(|&c| c < threshold).collect();
+        let relaxed = |among: &[usize], at: &[DVec3]| -> Vec<Fill> {
+            let mut points: Vec<DVec3> = among.iter().map(|&c| at[c]).collect();
+            let movable: Vec<usize> = (0..among.len())
+                .filter(|&k| moved.contains(&among[k]))
+                .collect();
+            crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS);
+            (among.iter().zip(points))
+                .filter(|&(&c, _)| c % parents == missing % parents)
+                .map(|(&c, target)| self.fill(c, digit, target))
+                .collect()
+        };
+        let held = relaxed(&local, &self.current);
+        let with_bin: Vec<usize> = (near.iter().copied())
+            .filter(|c| !joint.contains(c))
+            .collect();
+        let alone = relaxed(&with_bin, &self.sites);
+        FillProblem {
+            threshold,
+            missing,
+            orbit,
+            joint,
+            local,
+            moved,
+            candidates: [held, alone],
+        }
+    }
+
+    /// The fill of the tile of code `code`, a sibling of a missing digit
+    /// `digit`, whose point the relaxation took to `target`.
+    fn fill(&self, code: usize, digit: usize, target: DVec3) -> Fill {
+        let (tiling, lut, level) = (self.tiling, self.lut, self.level as usize);
+        let tile = &self.by_code[code];
+        let unmoved = lut.tables[level][self.bin][lut.row(level, tile.index as usize)];
+        let mut current = crate::lut::dequantise(unmoved);
+        for _ in 0..3 {
+            let site = tiling.face_point(tile, current).to_vec();
+            current = to_local(tiling, tile, current, site, target);
+        }
+        let stored =
+            SphereLut::quantise(self.within_room(crate::lut::dequantise(unmoved), current));
+        let pair = digit * (digit - 1) / 2 + code / self.parents;
+        let parent = lut.row(level - 1, tile.index as usize / 4);
+        Fill {
+            code,
+            row: parent * FILL_PAIRS + pair,
+            stored,
+            placed: tiling
+                .face_point(tile, crate::lut::dequantise(stored))
+                .to_vec(),
+            unmoved,
+        }
+    }
+
+    /// The point of the segment from `from` (inside the tile's room, the
+    /// dilated tile) to `to` farthest along it inside the room: a target
+    /// clamped to the room's nearest point moved sideways, next to a
+    /// neighbour the relaxation had kept clear of.
+    fn within_room(&self, from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
+        let room = self.tiling.shape().dilated();
+        let at = |s: f64| [0, 1].map(|k| from[k] + s * (to[k] - from[k]));
+        let (mut inside, mut outside) = (0.0, 1.0);
+        if room.contains(to) {
+            inside = 1.0;
+        }
+        while outside - inside > 1e-3 && inside < 1.0 {
+            let mid = 0.5 * (inside + outside);
+            match room.contains(at(mid)) {
+                true => inside = mid,
+                false => outside = mid,
+            }
+        }
+        room.clamp(at(inside), 0.02)
+    }
+
+    /// Of `problem`'s candidate fills, each moved all the way, three
+    /// quarters, half, a quarter or none of the way from the tiles'
+    /// offsets, those that leave the smallest hole (see [`Self::hole`])
+    /// among those that keep every point of them [`FILL_GUARD`] spacings
+    /// from the others and from every point the requests reading them
+    /// hold: those of the codes below its threshold, where the fills
+    /// solved before place them (fills solved later are held to this one).
+    fn chosen(&self, problem: &FillProblem) -> Vec<Fill> {
+        let mut best: Option<(f64, Vec<Fill>)> = None;
+        for candidate in &problem.candidates {
+            for share in [1.0, 0.75, 0.5, 0.25, 0.0] {
+                let fills: Vec<Fill> = candidate.iter().map(|f| self.toward(f, share)).collect();
+                if share > 0.0 && !self.clear(problem, &fills) {
+                    continue;
+                }
+                let hole = self.hole(problem, &fills);
+                if best.as_ref().is_none_or(|(widest, _)| hole < *widest) {
+                    best = Some((hole, fills));
+                }
+            }
+        }
+        best.map(|(_, fills)| fills).unwrap_or_default()
+    }
+
+    /// The widest hole about `problem`'s missing points with `fills`
+    /// placed: the farthest a probe within [`HOLE_PROBES`] spacings of a
+    /// missing site lies from the points the requests reading them hold.
+    fn hole(&self, problem: &FillProblem, fills: &[Fill]) -> f64 {
+        let points: Vec<DVec3> = (problem.local.iter())
+            .map(|&c| {
+                fills
+                    .iter()
+                    .find(|f| f.code == c)
+                    .map_or(self.current[c], |f| f.placed)
+            })
+            .collect();
+        let step = 0.2;
+        let reach = (HOLE_PROBES / step) as i32;
+        let mut widest: f64 = 0.0;
+        for &j in &problem.joint {
+            let site = self.sites[j];
+            let east = site.any_orthonormal_vector();
+            let north = site.cross(east);
+            for (a, b) in (-reach..=reach).flat_map(|a| (-reach..=reach).map(move |b| (a, b))) {
+                let (u, v) = (a as f64 * step, b as f64 * step);
+                if u * u + v * v > HOLE_PROBES * HOLE_PROBES {
+                    continue;
+                }
+                let probe = (site + self.spacing * (u * east + v * north)).normalize();
+                let nearest = (points.iter())
+                    .map(|p| p.distance_squared(probe))
+                    .fold(f64::INFINITY, f64::min);
+                widest = widest.max(nearest);
+            }
+        }
+        widest
+    }
+
+    /// `fill` moved a share of the way from the bin's offset to its own.
+    fn toward(&self, fill: &Fill, share: f64) -> Fill {
+        let [from, to] = [fill.unmoved, fill.stored].map(crate::lut::dequantise);
+        let offset = [0, 1].map(|k| from[k] + share * (to[k] - from[k]));
+        let stored = SphereLut::quantise(offset);
+        let tile = &self.by_code[fill.code];
+        Fill {
+            stored,
+            placed: (self.tiling)
+                .face_point(tile, crate::lut::dequantise(stored))
+                .to_vec(),
+            ..*fill
+        }
+    }
+
+    /// Whether `fills`, for `problem`, pass the guard (see [`Self::chosen`]).
+    fn clear(&self, problem: &FillProblem, fills: &[Fill]) -> bool {
+        let guard = FILL_GUARD * self.spacing;
+        let reach = guard + self.farthest;
+        fills.iter().enumerate().all(|(i, fill)| {
+            let at = (skew() * fill.placed).to_array();
+            let near = self
+                .tree
+                .within_unsorted::<SquaredEuclidean>(&at, reach * reach);
+            (near.iter().map(|n| n.item as usize))
+                .filter(|&c| c < problem.threshold && !problem.moved.contains(&c))
+                .all(|c| self.current[c].distance(fill.placed) >= guard)
+                && (fills[i + 1..].iter()).all(|other| other.placed.distance(fill.placed) >= guard)
+        })
+    }
+
+    /// Moves the points of `problem`'s fills, and at ring levels their
+    /// twins' (the same rows, so the same offsets in their own frames);
+    /// returns the codes moved.
+    fn place(&mut self, problem: &FillProblem, fills: &[Fill]) -> Vec<usize> {
+        let mut placed = Vec::new();
+        for fill in fills.iter().filter(|f| f.stored != f.unmoved) {
+            let twins = match self.ring {
+                true => 0..4,
+                false => 0..0,
+            };
+            let lost_twins = twins
+                .map(|k| ((fill.code & !3) + k, (problem.missing & !3) + k))
+                .filter(|&(twin, lost)| {
+                    twin != fill.code && lost > self.below && lost < self.in_bin
+                });
+            for (code, _) in std::iter::once((fill.code, problem.missing)).chain(lost_twins) {
+                let offset = crate::lut::dequantise(fill.stored);
+                let point = self.tiling.face_point(&self.by_code[code], offset).to_vec();
+                self.current[code] = point;
+                self.farthest = self.farthest.max(point.distance(self.sites[code]));
+                placed.push(code);
+            }
+        }
+        placed
+    }
 }
 
 /// The offset (tile frame, cells) of the face point `offset` maps to,
