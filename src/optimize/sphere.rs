@@ -1983,16 +1983,15 @@ impl<'a> BinFills<'a> {
     fn place(&mut self, problem: &FillProblem, fills: &[Fill]) -> Vec<usize> {
         let mut placed = Vec::new();
         for fill in fills.iter().filter(|f| f.stored != f.unmoved) {
-            let twins = match self.ring {
-                true => 0..4,
-                false => 0..0,
-            };
-            let lost_twins = twins
-                .map(|k| ((fill.code & !3) + k, (problem.missing & !3) + k))
-                .filter(|&(twin, lost)| {
-                    twin != fill.code && lost > self.below && lost < self.in_bin
-                });
-            for (code, _) in std::iter::once((fill.code, problem.missing)).chain(lost_twins) {
+            // the twins of a ring's first face whose missing twin the bin
+            // may drop
+            let ring_twins = (0..if self.ring { 4 } else { 0 })
+                .filter(|&k| {
+                    let lost = (problem.missing & !3) + k;
+                    (fill.code & 3) != k && lost > self.below && lost < self.in_bin
+                })
+                .map(|k| (fill.code & !3) + k);
+            for code in std::iter::once(fill.code).chain(ring_twins) {
                 let offset = crate::lut::dequantise(fill.stored);
                 let point = self.tiling.face_point(&self.by_code[code], offset).to_vec();
                 self.current[code] = point;
