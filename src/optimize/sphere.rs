@@ -1653,6 +1653,8 @@ struct BinFills<'a> {
     parents: usize,
     /// Whether a ring's first face relaxes the fills its three twins share.
     ring: bool,
+    /// Where a tile's point may lie: the dilated tile.
+    room: Shape,
     /// Codes every request of the bin keeps, and the bin's codes.
     below: usize,
     in_bin: usize,
@@ -1692,6 +1694,7 @@ impl<'a> BinFills<'a> {
             bin,
             parents,
             ring: lut.rows(level as usize - 1) < parents,
+            room: tiling.shape().dilated(),
             below: lut.bin_codes(bin - 1, capacity) as usize,
             in_bin,
             spacing: (4.0 * std::f64::consts::PI / in_bin as f64).sqrt(),
@@ -1872,13 +1875,11 @@ impl<'a> BinFills<'a> {
     /// clamped to the room's nearest point moved sideways, next to a
     /// neighbour the relaxation had kept clear of.
     fn within_room(&self, from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
-        let room = self.tiling.shape().dilated();
+        let room = &self.room;
         let at = |s: f64| [0, 1].map(|k| from[k] + s * (to[k] - from[k]));
-        let (mut inside, mut outside) = (0.0, 1.0);
-        if room.contains(to) {
-            inside = 1.0;
-        }
-        while outside - inside > 1e-3 && inside < 1.0 {
+        let mut inside = if room.contains(to) { 1.0 } else { 0.0 };
+        let mut outside = 1.0;
+        while outside - inside > 1e-3 {
             let mid = 0.5 * (inside + outside);
             match room.contains(at(mid)) {
                 true => inside = mid,
@@ -1897,8 +1898,12 @@ impl<'a> BinFills<'a> {
     /// solved before place them (fills solved later are held to this one).
     fn chosen(&self, problem: &FillProblem) -> Vec<Fill> {
         let mut best: Option<(f64, Vec<Fill>)> = None;
-        for candidate in &problem.candidates {
+        for (k, candidate) in problem.candidates.iter().enumerate() {
             for share in [1.0, 0.75, 0.5, 0.25, 0.0] {
+                // none of the way is the same for every candidate
+                if share == 0.0 && k > 0 {
+                    continue;
+                }
                 let fills: Vec<Fill> = candidate.iter().map(|f| self.toward(f, share)).collect();
                 if share > 0.0 && !self.clear(problem, &fills) {
                     continue;
