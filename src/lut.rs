@@ -671,10 +671,21 @@ impl SphereLut {
 
     /// Quantises an offset (cells, tile frame) for storage.
     pub(crate) fn quantise(offset: [f64; 2]) -> [i8; 2] {
+        Self::quantise_on(offset, 1)
+    }
+
+    /// Quantises an offset on a grid `step` times coarser than the
+    /// table's: every stored value a multiple of `step`, which zstd then
+    /// stores in fewer bits (the run time reads it as any other).
+    pub(crate) fn quantise_on(offset: [f64; 2], step: u8) -> [i8; 2] {
+        let step = f64::from(step);
+        let (lowest, highest) = (
+            (f64::from(i8::MIN) / step).ceil() * step,
+            (f64::from(i8::MAX) / step).floor() * step,
+        );
         [0, 1].map(|k| {
-            ((offset[k] - OFFSET_CENTRE[k]) * OFFSET_SCALE)
-                .round()
-                .clamp(i8::MIN as f64, i8::MAX as f64) as i8
+            let units = (offset[k] - OFFSET_CENTRE[k]) * OFFSET_SCALE / step;
+            (units.round() * step).clamp(lowest, highest) as i8
         })
     }
 

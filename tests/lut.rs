@@ -87,3 +87,32 @@ fn every_row_of_a_per_tile_level_serves_some_tile() {
         assert!(used.iter().all(|&u| u), "level {level} leaves a row unused");
     }
 }
+
+/// The four shipped tables stay within issue 18's 4 MB budget.
+#[test]
+fn the_shipped_tables_fit_in_4_mb() {
+    let sizes = [
+        include_bytes!("../luts/sphere.lut").len(),
+        include_bytes!("../luts/penrose.lut").len(),
+        include_bytes!("../luts/ghexomino.lut").len(),
+        include_bytes!("../luts/ppentomino.lut").len(),
+    ];
+    let total: usize = sizes.iter().sum();
+    assert!(total < 4_000_000, "{sizes:?}: {total} bytes");
+}
+
+/// The last per-tile level's offsets and fills lie on the build's coarser
+/// grid (`BuildOptions::deep_tile_step`, 2), which is what keeps the
+/// sphere table within the budget.
+#[test]
+fn the_last_per_tile_level_lies_on_the_coarser_grid() {
+    let lut = sphere_lut();
+    let level = lut.exact_levels as usize - 1;
+    let even = |pairs: &[[i8; 2]]| pairs.iter().flatten().all(|v| v % 2 == 0);
+    for (bin, table) in lut.tables[level].iter().enumerate() {
+        assert!(even(table), "level {level} bin {bin}");
+    }
+    assert!(even(&lut.fills[level]), "fills of level {level}");
+    // the level above keeps the table's full resolution
+    assert!(!even(&lut.tables[level - 1][0]));
+}
