@@ -55,7 +55,8 @@ where
             points[i]
         )));
     }
-    if points.len() < 2 {
+    // no iteration moves nothing: skip the spatial sort and the copies
+    if points.len() < 2 || iterations == 0 {
         return Ok(());
     }
     let weight = |x: DVec3| match density.constant() {
