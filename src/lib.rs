@@ -59,5 +59,5 @@ pub mod tiling;
 mod voronoi;
 
 pub use error::Error;
-pub use sample::Sample;
+pub use sample::{Position, Sample};
 pub use sampler::Sampler;

@@ -111,7 +111,8 @@ pub struct SphereRequest {
     pub count: usize,
     /// Skip the exactness pass: the natural count near `count`.
     pub expected: bool,
-    /// Progressive (every prefix well spread) or the cheapest order.
+    /// Progressive (by rank), farthest first (every prefix evenly spread)
+    /// or the cheapest order: see [`Order`].
     pub order: Order,
     /// Sample in a uniformly random frame drawn from this seed (estimates
     /// averaged over seeds are unbiased); without it the set is
@@ -177,6 +178,9 @@ impl SphereRequest {
             }
             if self.relax > 0 {
                 return refuse("relaxation");
+            }
+            if self.order == Order::FarthestFirst {
+                return refuse("the farthest-first order");
             }
             // a window visits only the tiles reaching it
             let near = engine::collect_within(&tiling, &**density, self.count as f64, &|r| {
@@ -271,7 +275,10 @@ impl SphereRequest {
     ) -> Result<R, Error> {
         if let SphereDensity::Regions(d) = density {
             let tiling = self.tiling()?;
-            let uniform = d.constant().is_some() && self.within.is_none() && self.relax == 0;
+            let uniform = d.constant().is_some()
+                && self.within.is_none()
+                && self.relax == 0
+                && self.order != Order::FarthestFirst;
             let stream = engine::stream(&tiling, self.count).filter(|_| uniform);
             if let Some(stream) = stream {
                 // the frame of `Rotated::new(density, seed)`
@@ -665,7 +672,8 @@ pub struct PlaneRequest {
     pub count: usize,
     /// Skip the exactness pass: the natural count near `count`.
     pub expected: bool,
-    /// Progressive (every prefix well spread) or the cheapest order.
+    /// Progressive (by rank), farthest first (every prefix evenly spread)
+    /// or the cheapest order: see [`Order`].
     pub order: Order,
     /// Sample under a uniformly random toroidal shift drawn from this seed.
     pub seed: Option<u64>,
@@ -759,7 +767,10 @@ impl PlaneRequest {
         density: &dyn Density<PlaneRegion>,
         sink: impl FnOnce(&mut dyn Blocks<DVec2>) -> R,
     ) -> Result<R, Error> {
-        let streams = density.constant().is_some() && self.domain.is_none() && self.seed.is_none();
+        let streams = density.constant().is_some()
+            && self.domain.is_none()
+            && self.seed.is_none()
+            && self.order != Order::FarthestFirst;
         if streams {
             let tiling = self.tiling()?;
             let stream = tiling.stream(self.count);

@@ -74,7 +74,7 @@ pub trait TileSystem: Sync {
     /// A tile: small, copied through the recursion.
     type Tile: Copy + Send + Sync;
     /// A sample position.
-    type Point: Copy + Send + Sync;
+    type Point: crate::Position + Send + Sync;
     /// What a density needs to bound itself over a tile.
     type Region;
 
