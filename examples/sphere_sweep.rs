@@ -1,7 +1,9 @@
 //! The uniform-sphere quality sweep of issue 18: tessera, tessera after
 //! 1, 3 and 10 Lloyd iterations (`tessera::relax`), and the spherical
 //! Fibonacci lattice, at 60 log-spaced counts from 100 to 10^6 plus the
-//! counts on and just past bins and level boundaries, and 2·10^6.
+//! counts on and just past bins and level boundaries, and 2·10^6; and
+//! the prefixes of N/4 and N/16 points in the progressive and the
+//! farthest-first order.
 //!
 //!     cargo run --release --example sphere_sweep [-- --out docs/SPHERE_SWEEP.md]
 //!
@@ -18,6 +20,7 @@ use std::time::Instant;
 use tessera::baselines::elimination::weighted_sample_elimination;
 use tessera::baselines::spherical_fibonacci;
 use tessera::density::Uniform;
+use tessera::engine::Order;
 use tessera::metrics::sphere::{
     cap_discrepancy_l2, covering_radius, mesh_ratio, riesz1_normalized, separation,
 };
@@ -48,9 +51,10 @@ fn measure(points: &[DVec3], pairs: bool) -> Row {
 /// 10^6 on two cores: its heap updates dominate).
 const ELIMINATION_UP_TO: usize = 300_000;
 
-/// Uniform requests whose progressive prefixes of lengths N/4 and N/16
-/// issue 18 measures (separation at least 2.0, covering at most 3.6).
-const PREFIX_SETS: [usize; 3] = [3072, 20_000, 200_000];
+/// Uniform requests whose prefixes of lengths N/4 and N/16 are measured:
+/// issue 18's three (separation at least 2.0, covering at most 3.6), and
+/// 10^6.
+const PREFIX_SETS: [usize; 4] = [3072, 20_000, 200_000, 1_000_000];
 
 const METHODS: [&str; 6] = [
     "tessera",
@@ -126,13 +130,28 @@ fn main() {
     }
     let mut prefixes = Vec::new();
     for n in PREFIX_SETS {
-        let points: Vec<DVec3> = (Sampler::sphere().count(n).generate().expect("uniform"))
-            .into_iter()
-            .map(|s| s.position)
-            .collect();
+        let request = Sampler::sphere().count(n);
+        let timed = |order: Order| {
+            let start = Instant::now();
+            let samples = request.clone().order(order).generate().expect("uniform");
+            let seconds = start.elapsed().as_secs_f64();
+            let points: Vec<DVec3> = samples.into_iter().map(|s| s.position).collect();
+            (points, seconds)
+        };
+        let (progressive, progressive_s) = timed(Order::Progressive);
+        let (farthest, farthest_s) = timed(Order::FarthestFirst);
         for length in [n / 4, n / 16] {
-            let prefix = &points[..length];
-            prefixes.push((n, length, separation(prefix), covering_radius(prefix)));
+            let measure = |points: &[DVec3]| {
+                let prefix = &points[..length];
+                (separation(prefix), covering_radius(prefix))
+            };
+            prefixes.push(PrefixRow {
+                n,
+                length,
+                progressive: measure(&progressive),
+                farthest: measure(&farthest),
+                seconds: (progressive_s, farthest_s),
+            });
         }
     }
     let wall = start.elapsed().as_secs_f64();
@@ -159,13 +178,34 @@ fn cost_report(costs: &[(usize, f64, [f64; 3])]) -> String {
     s
 }
 
-/// The prefix table: `(N, prefix length, separation, covering)` rows.
-fn prefix_report(prefixes: &[(usize, usize, f64, f64)]) -> String {
-    let mut s = String::from("\n## Progressive prefixes\n\n");
-    s.push_str("The first N/4 and N/16 points of a uniform request of N (`Sampler::sphere().count(N)`, progressive order), measured as sets of their own length (issue 18's floors: separation ≥ 2.0, covering ≤ 3.6).\n\n");
-    s.push_str("| N | prefix | separation | covering |\n|---|---|---|---|\n");
-    for (n, length, sep, cov) in prefixes {
-        let _ = writeln!(s, "| {n} | {length} | {sep:.2} | {cov:.2} |");
+/// A prefix of a uniform request in both orders: (separation, covering)
+/// each, and the seconds each order's request took.
+struct PrefixRow {
+    n: usize,
+    length: usize,
+    progressive: (f64, f64),
+    farthest: (f64, f64),
+    seconds: (f64, f64),
+}
+
+/// The prefix table.
+fn prefix_report(prefixes: &[PrefixRow]) -> String {
+    let mut s = String::from("\n## Prefixes\n\n");
+    s.push_str("The first N/4 and N/16 points of a uniform request of N (`Sampler::sphere().count(N)`), measured as sets of their own length (issue 18's floors, for N up to 200,000: separation ≥ 2.0, covering ≤ 3.6), in the progressive order (by rank, the default) and farthest first (`.order(Order::FarthestFirst)`, `tessera sphere --farthest-first`: the same points, each the farthest from those before it). The seconds are one run of the whole request on 2 threads (shared machine; `cargo bench --bench order` has medians).\n\n");
+    s.push_str("| N | prefix | progressive separation / covering | farthest first separation / covering | request s: progressive / farthest first |\n|---|---|---|---|---|\n");
+    for row in prefixes {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2} / {:.2} | {:.2} / {:.2} | {:.3} / {:.3} |",
+            row.n,
+            row.length,
+            row.progressive.0,
+            row.progressive.1,
+            row.farthest.0,
+            row.farthest.1,
+            row.seconds.0,
+            row.seconds.1
+        );
     }
     s
 }

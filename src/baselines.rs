@@ -1,7 +1,8 @@
 //! Baseline point sets to compare samplers against: the spherical Fibonacci
 //! lattice, independent uniform points on the sphere and in the square, the
 //! jittered grid and jittered HEALPix, weighted sample elimination
-//! ([`elimination`]), Owen-scrambled Sobol ([`sobol`])
+//! ([`elimination`]), exact farthest-point ordering ([`farthest_point`]),
+//! Owen-scrambled Sobol ([`sobol`])
 //! warped by inverse CDFs ([`cdf`], [`envmap`]), with a small self-contained RNG ([`SplitMix64`]) so
 //! that results are reproducible from a seed without extra dependencies.
 //!
@@ -15,6 +16,7 @@
 pub mod cdf;
 pub mod elimination;
 pub mod envmap;
+pub mod farthest_point;
 pub mod median_cut;
 pub mod sobol;
 

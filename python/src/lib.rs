@@ -105,11 +105,15 @@ fn run<T: Send>(
     result.map_err(PyErr::from)
 }
 
-fn order(unsorted: bool) -> Order {
-    if unsorted {
-        Order::Unsorted
-    } else {
-        Order::Progressive
+/// The order `unsorted` and `farthest_first` ask for (not both).
+fn order(unsorted: bool, farthest_first: bool) -> Result<Order, Error> {
+    match (unsorted, farthest_first) {
+        (true, true) => Err(Error::Request(
+            "unsorted and farthest_first are two orders; ask for one".into(),
+        )),
+        (true, false) => Ok(Order::Unsorted),
+        (false, true) => Ok(Order::FarthestFirst),
+        (false, false) => Ok(Order::Progressive),
     }
 }
 
@@ -352,7 +356,7 @@ type Columns<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// See `tessera.sphere`.
 #[pyfunction]
-#[pyo3(signature = (n, density, map, healpix, within, seed, threads, expected, unsorted, pdf, relax, table))]
+#[pyo3(signature = (n, density, map, healpix, within, seed, threads, expected, unsorted, farthest_first, pdf, relax, table))]
 #[allow(clippy::too_many_arguments)]
 fn sphere<'py>(
     py: Python<'py>,
@@ -365,6 +369,7 @@ fn sphere<'py>(
     threads: Option<usize>,
     expected: bool,
     unsorted: bool,
+    farthest_first: bool,
     pdf: bool,
     relax: usize,
     table: Option<PathBuf>,
@@ -375,7 +380,7 @@ fn sphere<'py>(
         let request = SphereRequest {
             count: n,
             expected,
-            order: order(unsorted),
+            order: order(unsorted, farthest_first)?,
             seed,
             within: within.as_deref().map(Cap::window).transpose()?,
             relax,
@@ -429,7 +434,7 @@ fn pdf<'py>(
 
 /// See `tessera.plane`.
 #[pyfunction]
-#[pyo3(signature = (n, system, density, image_path, image_array, invert, domain, seed, threads, expected, unsorted, pdf, table))]
+#[pyo3(signature = (n, system, density, image_path, image_array, invert, domain, seed, threads, expected, unsorted, farthest_first, pdf, table))]
 #[allow(clippy::too_many_arguments)]
 fn plane<'py>(
     py: Python<'py>,
@@ -444,6 +449,7 @@ fn plane<'py>(
     threads: Option<usize>,
     expected: bool,
     unsorted: bool,
+    farthest_first: bool,
     pdf: bool,
     table: Option<PathBuf>,
 ) -> PyResult<PointsOut<'py>> {
@@ -479,7 +485,7 @@ fn plane<'py>(
             system,
             count: n,
             expected,
-            order: order(unsorted),
+            order: order(unsorted, farthest_first)?,
             seed,
             domain: domain
                 .as_deref()

@@ -278,6 +278,7 @@ def sphere(
     threads=None,
     expected=False,
     unsorted=False,
+    farthest_first=False,
     pdf=False,
     relax=0,
     table=None,
@@ -344,6 +345,10 @@ def sphere(
     unsorted : bool
         The same samples in tile order instead of progressive order (a
         prefix is then not well spread).
+    farthest_first : bool
+        The same samples farthest first: each is the one farthest, in local
+        spacings, from those before it, so that every prefix is evenly
+        spread whatever its length (a sequential pass after sampling).
     pdf : bool
         Also return the pdf per steradian of each sample.
     relax : int
@@ -390,6 +395,7 @@ def sphere(
         _threads(threads),
         bool(expected),
         bool(unsorted),
+        bool(farthest_first),
         bool(pdf),
         _count(relax, "relax"),
         _path(table),
@@ -418,7 +424,7 @@ def pdf(
     ``up``, ``channel``, ``strict``); in a render loop pass a
     ``tessera.Map`` (or ``tessera.HealpixMap``), read once.
     ``sphere``'s other options (``within``, ``seed``, ``expected``,
-    ``unsorted``, ``relax``, ``table``, ``n``) are accepted and do not change the pdf,
+    ``unsorted``, ``farthest_first``, ``relax``, ``table``, ``n``) are accepted and do not change the pdf,
     as in ``tessera sphere --format csv``. Directions (an (n, 3) or (3,)
     array) need not be normalised.
 
@@ -431,7 +437,17 @@ def pdf(
     >>> bool((tessera.pdf(points, "cap:10,20,30,8") == p).all())
     True
     """
-    unknown = set(request) - {"n", "within", "seed", "expected", "unsorted", "relax", "pdf", "table"}
+    unknown = set(request) - {
+        "n",
+        "within",
+        "seed",
+        "expected",
+        "unsorted",
+        "farthest_first",
+        "relax",
+        "pdf",
+        "table",
+    }
     if unknown:
         raise TypeError(f"pdf() got unexpected keyword argument(s): {', '.join(sorted(unknown))}")
     directions = np.ascontiguousarray(directions, dtype=np.float64)
@@ -459,6 +475,7 @@ def plane(
     threads=None,
     expected=False,
     unsorted=False,
+    farthest_first=False,
     pdf=False,
     table=None,
 ):
@@ -487,7 +504,7 @@ def plane(
         unit square stretched over it).
     seed : int, optional
         Sample under a uniformly random toroidal shift drawn from this seed.
-    threads, expected, unsorted : as for ``sphere``.
+    threads, expected, unsorted, farthest_first : as for ``sphere``.
     pdf : bool
         Also return the pdf per unit area of the domain of each sample.
     table : path, optional
@@ -521,6 +538,7 @@ def plane(
         _threads(threads),
         bool(expected),
         bool(unsorted),
+        bool(farthest_first),
         bool(pdf),
         _path(table),
     )

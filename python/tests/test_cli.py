@@ -34,6 +34,11 @@ SPHERE_REQUESTS = [
     (dict(n=3000, seed=2**64 - 1), ["--seed", str(2**64 - 1)]),
     (dict(n=2500, density="cap:1,2,40,8", expected=True), ["--density", "cap:1,2,40,8", "--expected"]),
     (dict(n=2500, density="cap:1,2,40,8", unsorted=True), ["--density", "cap:1,2,40,8", "--unsorted"]),
+    (dict(n=3000, farthest_first=True), ["--farthest-first"]),
+    (
+        dict(n=2500, density="cap:1,2,40,8", seed=3, farthest_first=True),
+        ["--density", "cap:1,2,40,8", "--seed", "3", "--farthest-first"],
+    ),
     (dict(n=200000, within=(2.35, 48.85, 4)), ["--within", "2.35,48.85,4"]),
     (dict(n=200000, density="cap:0,0,10,20", within="5,5,6"), ["--density", "cap:0,0,10,20", "--within", "5,5,6"]),
     (dict(n=800, density="cap:0,90,40,5", relax=2), ["--density", "cap:0,90,40,5", "--relax", "2"]),
@@ -182,6 +187,7 @@ PLANE_REQUESTS = [
         ["--system", "ppentomino", "--density", "ramp", "--domain=-1,-1,1,3", "--seed", "9", "--unsorted"],
     ),
     (dict(n=2000, system="penrose", expected=True), ["--system", "penrose", "--expected"]),
+    (dict(n=3000, density="ramp", farthest_first=True), ["--system", "ghexomino", "--density", "ramp", "--farthest-first"]),
 ]
 
 
