@@ -197,6 +197,43 @@ fn output_is_progressive() {
 }
 
 #[test]
+fn farthest_first_prefixes_stay_spread_at_every_length() {
+    // the rank order's prefixes of a uniform request are the first codes
+    // of one level, placed for the full count: down to 0.09 at N/64
+    let n = 20_000;
+    let penrose = PenroseTiling::default();
+    let [(_, ghexomino), (_, ppentomino)] = systems();
+    let both = |points: &dyn Fn(Order) -> Vec<DVec2>| {
+        (points(Order::Progressive), points(Order::FarthestFirst))
+    };
+    let cases = [
+        ("G-hexomino", both(&|o| ordered(&ghexomino, n, o))),
+        ("P-pentomino", both(&|o| ordered(&ppentomino, n, o))),
+        ("Penrose", both(&|o| ordered(&penrose, n, o))),
+    ];
+    for (name, (progressive, farthest)) in cases {
+        for length in [n, n / 2, n / 4, n / 16, n / 64] {
+            let (p, f) = (
+                min_distance(&progressive[..length]),
+                min_distance(&farthest[..length]),
+            );
+            println!("{name}, first {length} of {n}: min distance {p:.3} progressive, {f:.3} farthest first");
+            assert!(f >= 0.55, "{name}, first {length}: {f}");
+        }
+    }
+}
+
+/// The positions of a uniform request of `n` in `order`.
+fn ordered<S: TileSystem<Point = DVec2, Region = PlaneRegion>>(
+    system: &S,
+    n: usize,
+    order: Order,
+) -> Vec<DVec2> {
+    let samples = engine::generate_ordered(system, &Uniform, n, true, order).unwrap();
+    samples.into_iter().map(|s| s.position).collect()
+}
+
+#[test]
 fn one_and_two_threads_give_the_same_samples() {
     let run = |threads: usize| {
         common::on_threads(threads, || {

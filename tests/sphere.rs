@@ -223,6 +223,7 @@ fn farthest_first_prefixes_of_an_adaptive_set_follow_the_density() {
     // come out later, 4-8 % off at 10,000 and 15,000)
     for length in [1000, 5000, 10_000, 15_000] {
         let part = share(&spread[..length]);
+        eprintln!("first {length}: {part:.4} inside the cap (the set: {whole:.4})");
         assert!(
             (part - whole).abs() < 0.1 * whole,
             "first {length}: {part} vs {whole}"
