@@ -42,35 +42,52 @@ pub(super) fn farthest_first<P: Position + Send + Sync>(
         return;
     }
     // worked on along a Morton curve: a pick's neighbours lie near each
-    // other in memory (twice as fast on 10^6 samples as the input order)
+    // other in memory (a quarter faster on 10^6 samples than the input order)
     let by_place = {
         let points: Vec<DVec3> = (samples.par_iter())
             .map(|s| DVec3::from_array(s.position.coordinates()))
             .collect();
         spatial_order(&points)
     };
+    // the working arrays are gone before the reordered copy is made
+    if let Some(order) = order_of_places(samples, &by_place, weight) {
+        *samples = (order.into_iter())
+            .map(|i| samples[by_place[i as usize]])
+            .collect();
+    }
+}
+
+/// The farthest-first order of `samples` taken in the order `by_place`,
+/// as indices into `by_place`; `None` when no weight is positive.
+fn order_of_places<P: Position + Send + Sync>(
+    samples: &[Sample<P>],
+    by_place: &[usize],
+    weight: Option<&(dyn Fn(P) -> f64 + Sync)>,
+) -> Option<Vec<u32>> {
+    let n = by_place.len();
     let at: Vec<[f64; 3]> = (by_place.par_iter())
         .map(|&i| samples[i].position.coordinates())
         .collect();
-    let weights: Vec<f64> = match weight {
-        Some(weight) => by_place
-            .par_iter()
-            .map(|&i| weight(samples[i].position))
-            .collect(),
+    // each sample's spacing relative to the densest's; a NaN or zero
+    // weight counts as the lightest
+    let spacings: Vec<f64> = match weight {
+        Some(weight) => {
+            let weights: Vec<f64> = (by_place.par_iter())
+                .map(|&i| weight(samples[i].position))
+                .collect();
+            let heaviest = weights.iter().copied().fold(0.0, f64::max);
+            if !(heaviest.is_finite() && heaviest > 0.0) {
+                // no density to measure spacings by: keep the order
+                return None;
+            }
+            (weights.iter())
+                .map(|&w| heaviest / w.max(heaviest * WEIGHT_RANGE))
+                .collect()
+        }
         None => vec![1.0; n],
     };
     // the input's first sample starts
     let first = by_place.iter().position(|&i| i == 0).unwrap_or(0);
-    let heaviest = weights.iter().copied().fold(0.0, f64::max);
-    if !(heaviest.is_finite() && heaviest > 0.0) {
-        // no density to measure spacings by: keep the order
-        return;
-    }
-    // each sample's spacing relative to the densest's; a NaN or zero
-    // weight counts as the lightest
-    let spacings: Vec<f64> = (weights.iter())
-        .map(|&w| heaviest / w.max(heaviest * WEIGHT_RANGE))
-        .collect();
     let octaves = Octaves::new(&at, &spacings);
     // squared distance in mean spacings
     let scaled2 =
@@ -94,10 +111,8 @@ pub(super) fn farthest_first<P: Position + Send + Sync>(
     for (i, &d2) in distance2.iter().enumerate().filter(|&(i, _)| i != first) {
         push(&mut queue, bands.of(d2), i);
     }
-    let mut done = vec![false; n];
-    done[first] = true;
     let mut order = Vec::with_capacity(n);
-    order.push(first);
+    order.push(first as u32);
     let mut band = 0;
     while band < queue.len() {
         let Some(i) = queue[band].pop() else {
@@ -112,9 +127,10 @@ pub(super) fn farthest_first<P: Position + Send + Sync>(
             push(&mut queue, now, i);
             continue;
         }
-        done[i] = true;
-        order.push(i);
         let reach = distance2[i].sqrt();
+        // chosen: at distance 0, which no update lowers
+        distance2[i] = 0.0;
+        order.push(i as u32);
         if reach == 0.0 {
             // the rest coincide with chosen samples: nothing shortens
             continue;
@@ -125,14 +141,14 @@ pub(super) fn farthest_first<P: Position + Send + Sync>(
             for near in tree.within_unsorted::<SquaredEuclidean>(&at[i], radius * radius) {
                 let j = members[near.item as usize] as usize;
                 let d2 = scaled2(near.distance, i, j);
-                if d2 < distance2[j] && !done[j] {
+                if d2 < distance2[j] {
                     distance2[j] = d2;
                 }
             }
         }
     }
     debug_assert_eq!(order.len(), n);
-    *samples = order.into_iter().map(|i| samples[by_place[i]]).collect();
+    Some(order)
 }
 
 /// The squared chord between two points.

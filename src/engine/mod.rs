@@ -337,7 +337,16 @@ where
     D: Density<S::Region> + ?Sized,
 {
     if order == Order::FarthestFirst {
-        // the same samples, cheapest first, then reordered
+        // (its queue holds 32-bit indices)
+        if count > u32::MAX as usize {
+            buffers.samples.clear();
+            return Err(Error::Request(format!(
+                "the farthest-first order takes at most {} samples, not {count}",
+                u32::MAX
+            )));
+        }
+        // the same samples by rank, then reordered from the first (the
+        // ranking sort is small beside the reordering)
         generate_into(system, density, count, exact, Order::Progressive, buffers)?;
         let weight = |p: S::Point| density.value(p).sqrt();
         let weight: Option<&(dyn Fn(S::Point) -> f64 + Sync)> = match density.constant() {
