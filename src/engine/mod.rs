@@ -284,8 +284,9 @@ impl<P> Buffers<P> {
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Order {
-    /// By rank: every prefix is itself a well-spread set, as a smaller
-    /// request would give.
+    /// By rank: every prefix is the samples a smaller request's thresholds
+    /// keep, at this request's places: it follows the density, spread
+    /// though less evenly than the whole set.
     #[default]
     Progressive,
     /// The same samples in whatever order is cheapest to produce (today:
