@@ -303,8 +303,8 @@ pub enum Order {
     /// every prefix, whatever its length, is about as evenly spread as the
     /// whole set (the rank order's prefixes leave holes: docs/SPHERE_SWEEP.md).
     /// The same samples as the other orders; their ranks no longer increase.
-    /// It costs a sequential O(N log N) pass after sampling, 1.3 µs a
-    /// sample at 2·10^5 and 2.1 µs at 10^6 (`cargo bench --bench order`,
+    /// It costs a sequential O(N log N) pass after sampling, 1.2 µs a
+    /// sample at 2·10^5 and 2.2 µs at 10^6 (`cargo bench --bench order`,
     /// docs/PERFORMANCE.md), for callers that stop at a prefix they choose
     /// later. Deterministic, and independent of the thread count.
     FarthestFirst,

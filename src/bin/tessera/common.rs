@@ -23,7 +23,7 @@ pub(crate) struct RequestArgs {
     /// Write the same samples farthest first: each is the one farthest
     /// (in local spacings) from those before it, so every prefix of the
     /// file is evenly spread, whatever its length (a sequential pass after
-    /// sampling: 1.3-2.1 µs a sample at 2·10^5-10^6).
+    /// sampling: 1.2-2.2 µs a sample at 2·10^5-10^6).
     #[arg(long)]
     pub(crate) farthest_first: bool,
     /// Output file, `-` for standard output.
