@@ -4,6 +4,10 @@
 //! version; `luts/*.provenance.json` beside it records the command, seed,
 //! parameters and resulting metrics. `tessera lut build` regenerates both.
 
+mod drop_moves;
+
+pub use drop_moves::{DropMoves, MOST_MOVES_A_ROW};
+
 use crate::polyomino::{Lattice, Placement, Rule};
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -33,7 +37,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 7;
+pub const SPHERE_LUT_VERSION: u32 = 8;
 
 /// zstd level sphere tables are written with: the highest, as a table is
 /// written once and read at every start (decoding speed does not depend on
@@ -117,8 +121,14 @@ pub struct SphereLut {
     /// [`SphereLut::fill_pair`]): a request between two bins keeps a prefix
     /// of the upper bin's set, and where that drops one child of a parent,
     /// its lower siblings take these offsets, relaxed with it missing and
-    /// every other point of the bin in place.
+    /// every other point of the bin in place. Levels with drop moves have
+    /// none (an empty table).
     pub fills: Vec<Offsets>,
+    /// Drop moves of the first per-tile levels, per level and bin (levels
+    /// from `drop_moves.len()` on have none; see [`DropMoves`]): a request
+    /// between two bins moves the points beside each code it drops as the
+    /// builder moved them, dropping the bin's codes from the top.
+    pub drop_moves: Vec<Vec<DropMoves>>,
 }
 
 /// One offset table (`i8` pairs, see [`SphereLut::tables`]), kept in its
@@ -228,28 +238,51 @@ impl RowOrder {
     }
 }
 
-/// One level's offsets (and sibling fills) in one importance bin, as
-/// [`SphereLut::level_offsets`] resolves them for a request.
+/// One level's offsets in one importance bin, with what a request between
+/// two bins reads in their place beside the codes it drops (the drop
+/// moves, or on the levels without them the sibling fills), as
+/// [`SphereLut::request_offsets`] resolves them once for a request.
 pub(crate) struct LevelOffsets<'a> {
     lut: &'a SphereLut,
     level: usize,
     table: &'a [[i8; 2]],
-    /// The level's fills, or empty where unused.
-    fills: &'a [[i8; 2]],
+    /// The level's drop moves in the bin, and the first key the request
+    /// drops.
+    moves: Option<(&'a DropMoves, u16)>,
+    /// The level's sibling fills, and the request's counts.
+    fills: Option<(&'a [[i8; 2]], FillCounts)>,
 }
 
 impl LevelOffsets<'_> {
-    /// The offset (tile frame, cells) of structural index `index`.
+    /// The bin's offset (tile frame, cells) of structural index `index`.
     #[inline]
     pub fn offset(&self, index: usize) -> [f64; 2] {
         dequantise(self.table[self.lut.row(self.level, index)])
     }
 
-    /// The sibling-fill offset of entry `pair` of the parent of tree
-    /// index `parent` (see [`SphereLut::fill`]).
+    /// The offset (tile frame, cells) of the tile of tree index `index`
+    /// and code `code` in the request: its drop move or sibling fill where
+    /// the request drops a code beside it, else the bin's.
+    /// `shares_a_hole` is [`SphereLut::fill_pair`]'s.
     #[inline]
-    pub fn fill(&self, parent: usize, pair: usize) -> [f64; 2] {
-        dequantise(self.fills[self.lut.row(self.level - 1, parent) * FILL_PAIRS + pair])
+    pub fn placed(
+        &self,
+        index: usize,
+        code: u64,
+        shares_a_hole: impl FnOnce(u64) -> bool,
+    ) -> [f64; 2] {
+        let row = self.lut.row(self.level, index);
+        let moved = match (self.moves, &self.fills) {
+            (Some((moves, dropped_from)), _) => {
+                let ring = self.level >= self.lut.ring_from as usize;
+                moves.offset(row, dropped_from, ring.then_some((code & 3) as u8))
+            }
+            (None, Some((fills, counts))) => (counts.pair(code, shares_a_hole))
+                // tree indices: the parent's is the tile's over 4
+                .map(|pair| fills[self.lut.row(self.level - 1, index / 4) * FILL_PAIRS + pair]),
+            (None, None) => None,
+        };
+        dequantise(moved.unwrap_or(self.table[row]))
     }
 }
 
@@ -425,6 +458,9 @@ impl SphereLut {
                 *table = Offsets::from(table.decode()?);
             }
         }
+        for moves in lut.drop_moves.iter_mut().flatten() {
+            moves.unpack()?;
+        }
         lut.validate()?;
         Ok(lut)
     }
@@ -432,7 +468,8 @@ impl SphereLut {
     /// Reads the header frame and keeps each offset table in its frame.
     /// The file is zstd frames: the table with its offset tables empty,
     /// then each of `tables` (level by level, bin by bin), then each of
-    /// `fills`, as raw pairs.
+    /// `fills`, as raw pairs, then each of `drop_moves` (level by level,
+    /// bin by bin; see [`DropMoves`]).
     fn read(bytes: &[u8]) -> Result<Self, Error> {
         let mut frames = Frames(bytes);
         let header = decompress(frames.next().unwrap_or(bytes))?;
@@ -451,6 +488,14 @@ impl SphereLut {
                 Error::Table("sphere table does not decompress: it ends before its offsets".into())
             })?;
             *table = Offsets::packed(frame, order);
+        }
+        for moves in lut.drop_moves.iter_mut().flatten() {
+            let frame = frames.next().ok_or_else(|| {
+                Error::Table(
+                    "sphere table does not decompress: it ends before its drop moves".into(),
+                )
+            })?;
+            *moves = DropMoves::packed(frame);
         }
         Ok(lut)
     }
@@ -494,12 +539,18 @@ impl SphereLut {
         for table in header.tables.iter_mut().flatten().chain(&mut header.fills) {
             *table = Offsets::default();
         }
+        for moves in header.drop_moves.iter_mut().flatten() {
+            *moves = DropMoves::default();
+        }
         let raw = postcard::to_allocvec(&header).expect("serialising to memory cannot fail");
         let mut bytes = zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL)
             .expect("compressing in memory cannot fail");
         let tables = self.tables.iter().flatten().chain(&self.fills);
         for (table, order) in tables.zip(self.row_orders()) {
             bytes.extend(table.compress(order));
+        }
+        for moves in self.drop_moves.iter().flatten() {
+            bytes.extend(moves.compress());
         }
         bytes
     }
@@ -514,27 +565,50 @@ impl SphereLut {
     /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, level: usize, index: usize, bin: usize) -> [f64; 2] {
-        self.level_offsets(level, bin, false).offset(index)
+        self.bin_offsets(level, bin).offset(index)
     }
 
-    /// The offsets and, `with_fills`, the sibling fills that the tiles of
-    /// `level` read in bin `bin`, found (and decoded) once for a request's
-    /// samples rather than once a sample.
-    pub(crate) fn level_offsets(
-        &self,
-        level: usize,
-        bin: usize,
-        with_fills: bool,
-    ) -> LevelOffsets<'_> {
+    /// The offsets that the tiles of `level` read in bin `bin`.
+    fn bin_offsets(&self, level: usize, bin: usize) -> LevelOffsets<'_> {
         LevelOffsets {
             lut: self,
             level,
             table: &self.tables[level.min(self.tables.len() - 1)][bin],
-            fills: match with_fills {
-                true => &self.fills[level],
-                false => &[],
-            },
+            moves: None,
+            fills: None,
         }
+    }
+
+    /// The offsets, and the drop moves or sibling fills, that the tiles
+    /// of `level` read at density `fraction` of the level (capacity
+    /// `capacity`, importance bin `bin`), found (and decoded) once for a
+    /// request's samples rather than once a sample.
+    pub(crate) fn request_offsets(
+        &self,
+        level: u32,
+        fraction: f64,
+        capacity: f64,
+        bin: usize,
+    ) -> LevelOffsets<'_> {
+        let mut offsets = self.bin_offsets(level as usize, bin);
+        let moves = self
+            .drop_moves
+            .get(level as usize)
+            .and_then(|bins| bins.get(bin));
+        match moves.filter(|_| bin > 0) {
+            Some(moves) => {
+                // whole numbers below 2^53 at the per-tile levels
+                let accepted = accepted_count(fraction, capacity) as u64;
+                let lower = self.bin_codes(bin - 1, capacity);
+                let dropped_from = accepted.saturating_sub(lower).min(u64::from(u16::MAX));
+                offsets.moves = Some((moves, dropped_from as u16));
+            }
+            None => {
+                let counts = self.fill_counts(level, fraction, capacity, bin);
+                offsets.fills = counts.map(|counts| (&self.fills[level as usize][..], counts));
+            }
+        }
+        offsets
     }
 
     /// Rows of the offset table of tree-indexed level `level`: one a tile,
@@ -598,22 +672,26 @@ impl SphereLut {
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// let capacity = 3840.0; // level 2; 960 parents
-    /// let fraction = 1300.0 / capacity;
+    /// // level 5, the first with sibling fills; 61,440 parents
+    /// assert_eq!(lut.drop_moves.len(), 5);
+    /// let capacity = 245_760.0;
+    /// let fraction = 83_200.0 / capacity;
     /// let bin = lut.bin(fraction, capacity);
-    /// // bin 3 keeps codes below 1401.1, so the parent of code 1350
-    /// // (code 1350 - 960 = 390) lacks its digit-1 child; its digit-0
-    /// // child, code 390, fills in
+    /// // bin 3 keeps codes below 89,671, so the parent of code 86,400
+    /// // (86,400 - 61,440 = 24,960) lacks its digit-1 child; its digit-0
+    /// // child, code 24,960, fills in
     /// let apart = |_| false;
-    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, apart), Some(0));
-    /// // the parent of code 291 keeps both children the bin has
-    /// assert_eq!(lut.fill_pair(291, 2, fraction, bin, capacity, apart), None);
-    /// // keeping codes below 1350 keeps 1348 and 1349, twins of code 1350:
-    /// // a fill next to a pole assumed them missing
-    /// let fraction = 1350.0 / capacity;
+    /// assert_eq!(lut.fill_pair(24_960, 5, fraction, bin, capacity, apart), Some(0));
+    /// // the parent of code 18,624 keeps both children the bin has
+    /// assert_eq!(lut.fill_pair(18_624, 5, fraction, bin, capacity, apart), None);
+    /// // keeping codes below 86,402 keeps 86,400 and 86,401, twins of
+    /// // code 86,402: a fill next to a pole assumed them missing
+    /// let fraction = 86_402.0 / capacity;
     /// let bin = lut.bin(fraction, capacity);
-    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, apart), Some(0));
-    /// assert_eq!(lut.fill_pair(390, 2, fraction, bin, capacity, |_| true), None);
+    /// assert_eq!(lut.fill_pair(24_962, 5, fraction, bin, capacity, apart), Some(0));
+    /// assert_eq!(lut.fill_pair(24_962, 5, fraction, bin, capacity, |_| true), None);
+    /// // the levels with drop moves have none
+    /// assert_eq!(lut.fill_pair(390, 2, 1300.0 / 3840.0, 3, 3840.0, apart), None);
     /// ```
     pub fn fill_pair(
         &self,
@@ -637,7 +715,7 @@ impl SphereLut {
         capacity: f64,
         bin: usize,
     ) -> Option<FillCounts> {
-        if level == 0 || level as usize >= self.fills.len() {
+        if level == 0 || self.fills.get(level as usize).is_none_or(|f| f.is_empty()) {
             return None;
         }
         // whole numbers below 2^53 at the per-tile levels
@@ -650,23 +728,17 @@ impl SphereLut {
     }
 
     /// The sibling-fill offset (tile frame, cells) of entry `pair` of the
-    /// parent of tree index `parent` at per-tile level `level`.
+    /// parent of tree index `parent` at per-tile level `level`, one with
+    /// fills (it panics on the others, as an index past a slice would).
     ///
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// let o = lut.fill(2, 0, 0);
+    /// let o = lut.fill(5, 0, 0);
     /// assert!((-1.0..=3.0).contains(&o[0]) && (-1.0..=4.0).contains(&o[1]));
     /// ```
     pub fn fill(&self, level: usize, parent: usize, pair: usize) -> [f64; 2] {
-        let fills = &self.fills[level];
-        let offsets = LevelOffsets {
-            lut: self,
-            level,
-            table: &[],
-            fills,
-        };
-        offsets.fill(parent, pair)
+        dequantise(self.fills[level][self.row(level - 1, parent) * FILL_PAIRS + pair])
     }
 
     /// Quantises an offset (cells, tile frame) for storage.
@@ -779,13 +851,40 @@ impl SphereLut {
         }
         for (level, fills) in self.fills.iter().enumerate() {
             let parents = if level == 0 { 0 } else { self.rows(level - 1) };
-            if fills.len() != parents * FILL_PAIRS {
+            let moved = level < self.drop_moves.len();
+            if fills.len() != parents * FILL_PAIRS && !(moved && fills.is_empty()) {
                 return bad(&format!("sibling-fill table {level} has the wrong size"));
             }
             if fills.iter().any(|&o| !inside(o)) {
                 return bad(&format!(
                     "sibling-fill table {level} has an offset outside the tile's neighbourhood"
                 ));
+            }
+        }
+        if self.drop_moves.len() > self.exact_levels as usize {
+            return bad("drop moves past the tree-indexed levels");
+        }
+        for (level, bins) in self.drop_moves.iter().enumerate() {
+            if bins.len() != self.bins() {
+                return bad(&format!(
+                    "drop-move table {level} has the wrong number of bins"
+                ));
+            }
+            let capacity = (ROOT_COUNT << (2 * level)) as f64;
+            for (bin, moves) in bins.iter().enumerate() {
+                // keys are codes less the lower bin's count, below this bin's
+                let width = match bin {
+                    0 => 0,
+                    _ => self.bin_codes(bin, capacity) - self.bin_codes(bin - 1, capacity),
+                };
+                let wrong = moves.rows() != self.rows(level) && !(bin == 0 && moves.is_empty());
+                // a move may take a point two cells past its tile, as far as
+                // an `i8` offset reaches
+                if wrong || moves.iter().any(|(_, key, _)| u64::from(key) >= width) {
+                    return bad(&format!(
+                        "drop-move table {level} bin {bin} has the wrong size or a key past its bin"
+                    ));
+                }
             }
         }
         Ok(())

@@ -46,15 +46,7 @@ pub fn relax<D>(points: &mut [DVec3], density: &D, iterations: usize) -> Result<
 where
     D: Density<SphereRegion> + ?Sized,
 {
-    if let Some(i) = points
-        .iter()
-        .position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6)
-    {
-        return Err(Error::Request(format!(
-            "relax: point {i} ({}) is not a unit vector",
-            points[i]
-        )));
-    }
+    unit_vectors(points, "relax")?;
     // no iteration moves nothing: skip the spatial sort and the copies
     if points.len() < 2 || iterations == 0 {
         return Ok(());
@@ -92,10 +84,43 @@ where
 }
 
 /// Uniform Lloyd iterations that move only the points at `movable`
-/// (indices into `points`) and hold the others in place: the table
-/// builder's sibling fills relax two or three points among about forty
-/// fixed neighbours, whose cells need not be computed.
-pub(crate) fn relax_among_fixed(points: &mut [DVec3], movable: &[usize], iterations: usize) {
+/// (indices into `points`) and hold the others in place: closing a hole
+/// takes its neighbours' moves, and only their cells are computed. The
+/// table builder's sibling fills relax two or three points among about
+/// forty fixed neighbours this way.
+///
+/// Errors: a point that is not a finite unit vector (to 1e-6), or an
+/// index past the points.
+///
+/// # Example
+/// ```
+/// use tessera::{metrics::sphere::covering_radius, relax::relax_among_fixed, Sampler};
+/// let mut points: Vec<_> = Sampler::sphere().count(500).generate().unwrap()
+///     .into_iter().map(|s| s.position).collect();
+/// // open a hole, then let the points beside it close it
+/// let hole = points.swap_remove(0);
+/// let wide = covering_radius(&points);
+/// let beside: Vec<usize> = (0..points.len())
+///     .filter(|&i| points[i].angle_between(hole) < 0.2)
+///     .collect();
+/// let far = (0..points.len()).find(|i| !beside.contains(i)).unwrap();
+/// let kept = points[far];
+/// relax_among_fixed(&mut points, &beside, 5).unwrap();
+/// assert!(covering_radius(&points) < wide);
+/// assert_eq!(points[far], kept);
+/// ```
+pub fn relax_among_fixed(
+    points: &mut [DVec3],
+    movable: &[usize],
+    iterations: usize,
+) -> Result<(), Error> {
+    unit_vectors(points, "relax_among_fixed")?;
+    if let Some(&i) = movable.iter().find(|&&i| i >= points.len()) {
+        return Err(Error::Request(format!(
+            "relax_among_fixed: movable index {i} is past the {} points",
+            points.len()
+        )));
+    }
     let mut normals = Vec::new();
     for _ in 0..iterations {
         let tree = build_tree(points);
@@ -109,6 +134,19 @@ pub(crate) fn relax_among_fixed(points: &mut [DVec3], movable: &[usize], iterati
         for (&i, p) in movable.iter().zip(moved) {
             points[i] = p;
         }
+    }
+    Ok(())
+}
+
+/// Refuses points that are not finite unit vectors (to 1e-6), naming
+/// the function `what` and the first such point.
+fn unit_vectors(points: &[DVec3], what: &str) -> Result<(), Error> {
+    match (points.iter()).position(|p| !p.is_finite() || (p.length() - 1.0).abs() > 1e-6) {
+        Some(i) => Err(Error::Request(format!(
+            "{what}: point {i} ({}) is not a unit vector",
+            points[i]
+        ))),
+        None => Ok(()),
     }
 }
 
@@ -299,7 +337,7 @@ mod tests {
             }
         }
         let mut some = start.clone();
-        relax_among_fixed(&mut some, &movable, 4);
+        relax_among_fixed(&mut some, &movable, 4).unwrap();
         for (k, (a, b)) in all.iter().zip(&some).enumerate() {
             assert!((*a - *b).length() < 1e-12, "point {k}: {a} against {b}");
         }
@@ -323,5 +361,14 @@ mod tests {
         let mut points = vec![DVec3::Z, DVec3::new(0.0, 0.0, 2.0)];
         let e = relax(&mut points, &Uniform, 1).unwrap_err().to_string();
         assert!(e.contains("point 1"), "{e}");
+        let e = relax_among_fixed(&mut points, &[0], 1)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("point 1"), "{e}");
+        points[1] = DVec3::X;
+        let e = relax_among_fixed(&mut points, &[2], 1)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("index 2"), "{e}");
     }
 }

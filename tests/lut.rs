@@ -35,12 +35,25 @@ fn bad_tables_are_refused_with_a_reason() {
     let mut far = (*sphere_lut()).clone();
     far.tables[0][0][0] = [i8::MAX, 0];
     assert!(err(&far.to_bytes()).contains("outside"));
+    let fills = sphere_lut().drop_moves.len();
     let mut short = (*sphere_lut()).clone();
-    short.fills[2].pop();
-    assert!(err(&short.to_bytes()).contains("sibling-fill table 2 has the wrong size"));
+    short.fills[fills].pop();
+    let expected = format!("sibling-fill table {fills} has the wrong size");
+    assert!(err(&short.to_bytes()).contains(&expected));
     let mut far_fill = (*sphere_lut()).clone();
-    far_fill.fills[1][0] = [0, i8::MIN];
-    assert!(err(&far_fill.to_bytes()).contains("sibling-fill table 1 has an offset outside"));
+    far_fill.fills[fills][0] = [0, i8::MIN];
+    let expected = format!("sibling-fill table {fills} has an offset outside");
+    assert!(err(&far_fill.to_bytes()).contains(&expected));
+    // drop moves: a row too few, and a key past its bin
+    let mut fewer = (*sphere_lut()).clone();
+    let rows: Vec<Vec<(u16, [i8; 2], u8)>> = vec![Vec::new(); fewer.rows(1) - 1];
+    fewer.drop_moves[1][3] = tessera::lut::DropMoves::from_rows(rows);
+    assert!(err(&fewer.to_bytes()).contains("drop-move table 1 bin 3 has the wrong size"));
+    let mut past = (*sphere_lut()).clone();
+    let mut rows: Vec<Vec<(u16, [i8; 2], u8)>> = vec![Vec::new(); past.rows(1)];
+    rows[0].push((u16::MAX, [0, 0], 0));
+    past.drop_moves[1][3] = tessera::lut::DropMoves::from_rows(rows);
+    assert!(err(&past.to_bytes()).contains("a key past its bin"));
     // ring-shared rows past the tree-indexed levels, and a table sized for
     // the wrong sharing
     let mut ring = (*sphere_lut()).clone();

@@ -99,8 +99,8 @@ impl<T: TileSystem, F: Fn(&T, &T::Tile, T::Point, f64) -> bool + Sync> TileSyste
 }
 
 /// Whether a sphere sample lies in its tile's room: the pentomino at full
-/// density, the pentomino grown by one cell (the room the offset tables may
-/// use) below it.
+/// density, below it the pentomino grown by three cells (the offset tables
+/// keep to one, drop moves to three).
 fn in_pentomino_room(tiling: &SphereTiling, tile: &SphereTile, p: DVec3, fraction: f64) -> bool {
     let fp = FacePoint::from_vec(p);
     let nside = SphereTiling::nside(tile.level as u32) as f64;
@@ -109,7 +109,7 @@ fn in_pentomino_room(tiling: &SphereTiling, tile: &SphereTile, p: DVec3, fractio
         // point on the edge maps back to either face: accept it there when
         // it is near the tile
         let on_edge = [fp.x, fp.y].iter().any(|&c| c.min(1.0 - c) < 1e-12);
-        let reach = FACE_LIPSCHITZ * 4.0 / nside;
+        let reach = FACE_LIPSCHITZ * 6.0 / nside;
         return on_edge && angle_between(p, tiling.region(tile).center()) <= reach;
     }
     let placement = tile.placement;
@@ -121,7 +121,7 @@ fn in_pentomino_room(tiling: &SphereTiling, tile: &SphereTile, p: DVec3, fractio
     let room = if fraction >= 1.0 {
         tiling.shape().clone()
     } else {
-        tiling.shape().dilated()
+        tiling.shape().dilated().dilated().dilated()
     };
     // a few ulps of slack for the face-coordinate round trip
     let eps = 1e-9;

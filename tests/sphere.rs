@@ -308,66 +308,73 @@ fn every_bins_own_count_gets_the_set_it_was_relaxed_on() {
 }
 
 #[test]
-fn sibling_fills_shrink_the_holes_between_bins_without_crowding() {
+fn drop_moves_close_the_holes_between_bins_without_crowding() {
     // between two bins a request keeps a prefix of the upper bin's set;
-    // where a parent loses a child, its other children take offsets relaxed
-    // for that hole. Without them (the same counts): separation >= 2.70,
-    // covering mean 3.95 and worst 5.17, mesh ratio worst 3.81. Format 5's
-    // orbit root ranks moved the holes: mean 3.49, worst 4.56 (N = 1644);
-    // the builder's seam fix (rows past a face edge move) 3.47 and 4.62;
-    // fills relaxed with a pole's whole ring orbit missing 3.46 and 4.62;
-    // fills solved in the order requests read them 3.39 and 4.62
+    // the kept points beside each code it drops take the places the
+    // builder relaxed them to, dropping the bin's codes from the top.
+    // Without any (the same counts): covering mean 3.95 and worst 5.17,
+    // mesh ratio worst 3.81; with the siblings of each dropped code alone
+    // moving (sibling fills, solved in the order requests read them): mean
+    // 3.39, worst 4.62, mesh ratio 3.32, separation at least 2.51. Drop
+    // moves: 2.95, 3.23, 2.41, 2.47
     use tessera::metrics::sphere::{covering_radius, separation};
     let (mut coverings, mut worst_mesh) = (Vec::new(), 0.0f64);
     for n in (965..3840).step_by(97) {
         let points = uniform_points(n);
         let (covering, spacing) = (covering_radius(&points), separation(&points));
-        assert!(spacing >= 2.5, "N = {n}: separation {spacing:.3}");
+        assert!(spacing >= 2.45, "N = {n}: separation {spacing:.3}");
         coverings.push(covering);
         worst_mesh = worst_mesh.max(2.0 * covering / spacing);
     }
     let mean = coverings.iter().sum::<f64>() / coverings.len() as f64;
     let worst = coverings.iter().cloned().fold(0.0, f64::max);
+    println!("covering mean {mean:.3}, worst {worst:.3}; mesh ratio worst {worst_mesh:.3}");
     assert!(
-        mean <= 3.42 && worst <= 4.65,
+        mean <= 3.1 && worst <= 3.4,
         "covering mean {mean:.3}, worst {worst:.3}"
     );
-    assert!(worst_mesh <= 3.4, "mesh ratio worst {worst_mesh:.3}");
+    assert!(worst_mesh <= 2.8, "mesh ratio worst {worst_mesh:.3}");
 }
 
 #[test]
-fn neighbouring_holes_between_bins_close_together() {
-    // most holes wider than 3.4 / sqrt(N) between bins were two adjacent
-    // dropped tiles; fills relaxed each with the rest of the bin's set in
-    // place left them open: covering 3.69 (N = 4238), 3.73 (10,812), 3.83
-    // (37,694). Solved in the order requests read them, each with the
-    // higher codes' fills in place: 3.28, 3.53, 3.48
+fn levels_with_drop_moves_meet_issue_18s_floors_at_the_sweeps_counts() {
+    // docs/SPHERE_SWEEP.md's counts between bins up to level 4's
+    // capacity: with sibling fills, covering <= 3.4 held at 17 of the 43
+    // and mesh ratio <= 2.8 at 38 (worst 4.64 and 3.32, N = 1661, a
+    // pole's hole); with drop moves at all (worst 3.36 and 2.69, N =
+    // 20,188; separation at least 2.50)
     use tessera::metrics::sphere::{covering_radius, separation};
-    for n in [4238, 10_812, 37_694] {
+    let counts = [
+        100, 117, 137, 160, 187, 218, 255, 298, 349, 408, 476, 557, 651, 761, 890, 1040, 1215,
+        1421, 1661, 1941, 2270, 2653, 3101, 3625, 4238, 4954, 5790, 6769, 7912, 9249, 10_812,
+        12_638, 14_774, 15_400, 17_270, 20_188, 23_598, 27_585, 32_246, 37_694, 44_062, 51_507,
+        60_209,
+    ];
+    for n in counts {
         let points = uniform_points(n);
         let (covering, spacing) = (covering_radius(&points), separation(&points));
-        assert!(covering <= 3.6, "N = {n}: covering {covering:.3}");
-        assert!(spacing >= 2.5, "N = {n}: separation {spacing:.3}");
+        let mesh = 2.0 * covering / spacing;
+        assert!(
+            spacing >= 2.4 && covering <= 3.4 && mesh <= 2.8,
+            "N = {n}: separation {spacing:.3}, covering {covering:.3}, mesh ratio {mesh:.3}"
+        );
     }
 }
 
 #[test]
 fn a_pole_keeps_no_hole_where_its_ring_orbit_is_dropped() {
     // the four tiles next to a pole, one ring orbit with consecutive codes,
-    // drop together; their siblings' fills, relaxed with the other three
+    // drop together: their siblings' fills, relaxed with the other three
     // in place, moved little, and the pole's hole set the covering: 4.08
-    // (N = 476), 4.49 (6769), 3.88 (14,774). Relaxed with the whole orbit
-    // missing: 3.49, 3.67, 3.53
+    // (N = 476), 4.49 (6769), 3.88 (14,774); relaxed with the whole orbit
+    // missing 3.49, 3.67, 3.53. Drop moves close it with the neighbours of
+    // every dropped twin
     use tessera::metrics::sphere::{covering_radius, separation};
-    for n in [476, 6769, 14_774] {
-        let covering = covering_radius(&uniform_points(n));
-        assert!(covering <= 3.7, "N = {n}: covering {covering:.3}");
-    }
-    // a request keeping part of such an orbit reads no fill there, as the
-    // fill assumed the kept twins gone (read anyway: 2.39 and 2.27)
-    for n in [491, 725] {
-        let spacing = separation(&uniform_points(n));
-        assert!(spacing >= 2.9, "N = {n}: separation {spacing:.3}");
+    for n in [476, 491, 725, 1661, 6769, 14_774] {
+        let points = uniform_points(n);
+        let (covering, spacing) = (covering_radius(&points), separation(&points));
+        assert!(covering <= 3.4, "N = {n}: covering {covering:.3}");
+        assert!(spacing >= 2.45, "N = {n}: separation {spacing:.3}");
     }
 }
 
@@ -534,8 +541,9 @@ fn streams_reach_the_deepest_level_without_buffering() {
 }
 
 /// `--relax`: Lloyd iterations approach a CVT's spacing from a set between
-/// bins and past level 3 (where the tables alone leave holes), and keep a
-/// cap's share of the points (the weight is the density squared).
+/// bins on level 5 (where the tables alone leave holes: no drop moves
+/// there), and keep a cap's share of the points (the weight is the
+/// density squared).
 #[test]
 fn lloyd_relaxation_evens_spacing_and_keeps_the_density() {
     use tessera::metrics::sphere::{covering_radius, mesh_ratio, separation};
@@ -543,7 +551,7 @@ fn lloyd_relaxation_evens_spacing_and_keeps_the_density() {
     let positions = |samples: Vec<tessera::Sample<DVec3>>| -> Vec<DVec3> {
         samples.into_iter().map(|s| s.position).collect()
     };
-    let mut points = positions(Sampler::sphere().count(20_000).generate().unwrap());
+    let mut points = positions(Sampler::sphere().count(82_272).generate().unwrap());
     assert!(
         mesh_ratio(&points) > 2.8,
         "the unrelaxed set misses issue 18's mesh-ratio floor here"

@@ -13,7 +13,13 @@
 //!    automaton between them;
 //! 6. offsets: Lloyd relaxation on the sphere itself (HEALPix cells as an
 //!    equal-area quadrature), per level and importance bin, with each
-//!    structural index sharing one offset.
+//!    structural index sharing one offset;
+//! 7. what a request between two bins reads beside the codes it drops:
+//!    sibling fills on the last per-tile levels, and on the first ones
+//!    drop moves (`drop_moves`), the places of every kept point near a
+//!    dropped code.
+
+mod drop_moves;
 
 use super::ranking::farthest_point_ranks;
 use crate::healpix::{self, Cell, Dir, FacePoint};
@@ -54,8 +60,14 @@ pub struct BuildOptions {
     /// First of the tree-indexed levels whose rows the four faces of a
     /// HEALPix ring share ([`SphereLut::row`]).
     pub ring_from: u8,
-    /// Sibling-fill tables: levels `1..fill_levels` get fills.
+    /// Sibling-fill tables: levels `1..fill_levels` get fills, but for
+    /// those with drop moves (their tables stay empty).
     pub fill_levels: u8,
+    /// Levels `0..drop_move_levels` get drop moves (see
+    /// [`crate::lut::DropMoves`]) in place of sibling fills. Their keys
+    /// are 16 bits wide, which holds the bins of levels 0-5; level 5's
+    /// moves (879 kB) would take the sphere table past the 4 MB budget.
+    pub drop_move_levels: u8,
     /// First level whose neighbourhood classes are enumerated and relaxed,
     /// below `exact_levels`: each class level relaxes from the one above,
     /// so the class table starts warm (started cold, its classes crowded
@@ -113,6 +125,7 @@ impl Default for BuildOptions {
             exact_levels: 7,
             ring_from: 4,
             fill_levels: 7,
+            drop_move_levels: 5,
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
@@ -205,11 +218,13 @@ pub fn build(
         || options.deep_tile_step == 0
         || options.class_depth > 10
         || options.class_separation_depth > 2
+        || options.drop_move_levels > options.exact_levels.min(6)
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
-             0 < fill_levels <= exact_levels, bins >= 6, deep_tile_step > 0, 0 < class_separation_depth <= 2)"
+             0 < fill_levels <= exact_levels, bins >= 6, deep_tile_step > 0, 0 < class_separation_depth <= 2, \
+             drop_move_levels <= min(exact_levels, 6))"
         )));
     }
     let mut report = BuildReport::default();
@@ -259,6 +274,7 @@ pub fn build(
         bin_fractions: crate::lut::bin_fractions(options.bins as usize),
         tables: Vec::new(),
         fills: Vec::new(),
+        drop_moves: Vec::new(),
     };
     lut.root_rank = root_ranks(&lut);
     let enumerator = SphereTiling::new(Arc::new(lut.clone()));
@@ -294,6 +310,9 @@ pub fn build(
     let fills = sibling_fills(&enumerator, &lut, options, progress);
     lut.fills = fills.into_iter().map(Offsets::from).collect();
     lap(&mut report, "sibling fills");
+
+    lut.drop_moves = drop_moves::drop_moves(&enumerator, &lut, options, progress);
+    lap(&mut report, "drop moves");
     Ok((lut, report))
 }
 
@@ -1645,15 +1664,17 @@ fn sibling_fills(
     progress: Progress,
 ) -> Vec<Vec<[i8; 2]>> {
     let fill_levels = u32::from(options.fill_levels);
-    let mut fills = vec![Vec::new()];
-    for level in 1..fill_levels {
+    let moved = u32::from(options.drop_move_levels);
+    let mut fills = vec![Vec::new(); moved.clamp(1, fill_levels) as usize];
+    for level in moved.max(1)..fill_levels {
         let step = options.grid_step(level);
         let unused = SphereLut::quantise_on(tiling.shape().centroid(), step);
         let mut by_code = tiling.tiles(level);
         by_code.sort_unstable_by_key(|t| t.code);
         let mut table = vec![unused; lut.rows(level as usize - 1) * FILL_PAIRS];
         for bin in 1..lut.bins() {
-            for (row, offset) in BinFills::new(tiling, lut, &by_code, bin, step).solve() {
+            let set = BinSet::new(tiling, lut, &by_code, bin);
+            for (row, offset) in BinFills::new(set, step).solve() {
                 table[row] = offset;
             }
         }
@@ -1698,25 +1719,69 @@ struct BinFills<'a> {
     step: u8,
 }
 
-impl<'a> BinFills<'a> {
+/// A bin's relaxed set on one per-tile level, which sibling fills and
+/// drop moves start from: the tiles of the codes below the bin's count
+/// at the bin's offsets, and a k-d tree of their points.
+struct BinSet<'a> {
+    tiling: &'a SphereTiling,
+    lut: &'a SphereLut,
+    /// The level's tiles by code.
+    by_code: &'a [SphereTile],
+    bin: usize,
+    capacity: f64,
+    sites: Vec<DVec3>,
+    tree: ImmutableKdTree<f64, u32, 3, 32>,
+}
+
+impl<'a> BinSet<'a> {
     fn new(
         tiling: &'a SphereTiling,
         lut: &'a SphereLut,
         by_code: &'a [SphereTile],
         bin: usize,
-        step: u8,
     ) -> Self {
-        let level = by_code[0].level as u32;
-        let capacity = tiling.capacity(level);
-        let parents = capacity as usize / 4;
+        let level = by_code[0].level as usize;
+        let capacity = tiling.capacity(level as u32);
         let in_bin = lut.bin_codes(bin, capacity) as usize;
         let sites: Vec<DVec3> = by_code[..in_bin]
             .par_iter()
             .map(|t| {
-                let offset = lut.offset(level as usize, t.index as usize, bin);
+                let offset = lut.offset(level, t.index as usize, bin);
                 tiling.face_point(t, offset).to_vec()
             })
             .collect();
+        BinSet {
+            tiling,
+            lut,
+            by_code,
+            bin,
+            capacity,
+            tree: site_tree(&sites),
+            sites,
+        }
+    }
+
+    /// The count of the bin below (every request of this bin keeps more).
+    fn below(&self) -> usize {
+        self.lut.bin_codes(self.bin - 1, self.capacity) as usize
+    }
+}
+
+impl<'a> BinFills<'a> {
+    fn new(set: BinSet<'a>, step: u8) -> Self {
+        let below = set.below();
+        let BinSet {
+            tiling,
+            lut,
+            by_code,
+            bin,
+            capacity,
+            sites,
+            tree,
+        } = set;
+        let level = by_code[0].level as u32;
+        let parents = capacity as usize / 4;
+        let in_bin = sites.len();
         BinFills {
             tiling,
             lut,
@@ -1726,10 +1791,10 @@ impl<'a> BinFills<'a> {
             parents,
             ring: lut.rows(level as usize - 1) < parents,
             room: tiling.shape().dilated(),
-            below: lut.bin_codes(bin - 1, capacity) as usize,
+            below,
             in_bin,
             spacing: (4.0 * std::f64::consts::PI / in_bin as f64).sqrt(),
-            tree: site_tree(&sites),
+            tree,
             current: sites.clone(),
             sites,
             farthest: 0.0,
@@ -1854,7 +1919,9 @@ impl<'a> BinFills<'a> {
             let movable: Vec<usize> = (0..among.len())
                 .filter(|&k| moved.contains(&among[k]))
                 .collect();
-            crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS);
+            // the bin's points are unit vectors, and `movable` indexes them
+            crate::relax::relax_among_fixed(&mut points, &movable, FILL_ITERATIONS)
+                .expect("a fill problem's points are unit vectors");
             (among.iter().zip(points))
                 .filter(|&(&c, _)| c % parents == missing % parents)
                 .map(|(&c, target)| self.fill(c, digit, target))
@@ -1888,7 +1955,7 @@ impl<'a> BinFills<'a> {
             current = to_local(tiling, tile, current, site, target);
         }
         let stored = SphereLut::quantise_on(
-            self.within_room(crate::lut::dequantise(unmoved), current),
+            within_room(&self.room, crate::lut::dequantise(unmoved), current),
             self.step,
         );
         let pair = digit * (digit - 1) / 2 + code / self.parents;
@@ -1902,25 +1969,6 @@ impl<'a> BinFills<'a> {
                 .to_vec(),
             unmoved,
         }
-    }
-
-    /// The point of the segment from `from` (inside the tile's room, the
-    /// dilated tile) to `to` farthest along it inside the room: a target
-    /// clamped to the room's nearest point moved sideways, next to a
-    /// neighbour the relaxation had kept clear of.
-    fn within_room(&self, from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
-        let room = &self.room;
-        let at = |s: f64| [0, 1].map(|k| from[k] + s * (to[k] - from[k]));
-        let mut inside = if room.contains(to) { 1.0 } else { 0.0 };
-        let mut outside = 1.0;
-        while outside - inside > 1e-3 {
-            let mid = 0.5 * (inside + outside);
-            match room.contains(at(mid)) {
-                true => inside = mid,
-                false => outside = mid,
-            }
-        }
-        room.clamp(at(inside), 0.02)
     }
 
     /// Of `problem`'s candidate fills, each moved all the way, three
@@ -2040,6 +2088,24 @@ impl<'a> BinFills<'a> {
         }
         placed
     }
+}
+
+/// The point of the segment from `from` (inside the tile's room, the
+/// dilated tile) to `to` farthest along it inside the room: a target
+/// clamped to the room's nearest point moved sideways, next to a
+/// neighbour the relaxation had kept clear of.
+fn within_room(room: &Shape, from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
+    let at = |s: f64| [0, 1].map(|k| from[k] + s * (to[k] - from[k]));
+    let mut inside = if room.contains(to) { 1.0 } else { 0.0 };
+    let mut outside = 1.0;
+    while outside - inside > 1e-3 {
+        let mid = 0.5 * (inside + outside);
+        match room.contains(at(mid)) {
+            true => inside = mid,
+            false => outside = mid,
+        }
+    }
+    room.clamp(at(inside), 0.02)
 }
 
 /// The offset (tile frame, cells) of the face point `offset` maps to,

@@ -349,11 +349,8 @@ impl SphereTiling {
         let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
         let bin = lut.bin(fraction, capacity);
         let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
-        match lut.fill_pair(tile.code, level, fraction, bin, capacity, shares) {
-            // tree indices: the parent's is the tile's over 4
-            Some(pair) => lut.fill(level as usize, tile.index as usize / 4, pair),
-            None => lut.offset(level as usize, tile.index as usize, bin),
-        }
+        let offsets = lut.request_offsets(level, fraction, capacity, bin);
+        offsets.placed(tile.index as usize, tile.code as u64, shares)
     }
 
     /// The shape of every tile.
@@ -589,22 +586,19 @@ impl TileSystem for SphereTiling {
             let source = Listed::new(self, list, listed_codes.start, m, depth, indexing, place);
             return Some(Box::new(source));
         }
-        // tiles indexed by tree position: an offset per tile (and its fill),
-        // with the request's bin, fill counts and tables found once
+        // tiles indexed by tree position: an offset per tile (or its drop
+        // move or fill), with the request's bin and tables found once
         let lut = &*self.lut;
         let capacity = self.capacity(level);
         let bin = lut.bin(fraction, capacity);
-        let fills = lut.fill_counts(level, fraction, capacity, bin);
-        let offsets = lut.level_offsets(level as usize, bin, fills.is_some());
+        let offsets = lut.request_offsets(level, fraction, capacity, bin);
         let place = move |t: &code_order::Placed, code: usize| {
-            let index = t.class as usize;
             let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
-            let offset = match fills.and_then(|f| f.pair(code as u64, shares)) {
-                // tree indices: the parent's is the tile's over 4
-                Some(pair) => offsets.fill(index / 4, pair),
-                None => offsets.offset(index),
-            };
-            sample(t, code, offset)
+            sample(
+                t,
+                code,
+                offsets.placed(t.class as usize, code as u64, shares),
+            )
         };
         let source = Listed::new(self, list, listed_codes.start, m, depth, indexing, place);
         Some(Box::new(source))

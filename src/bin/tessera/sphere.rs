@@ -61,8 +61,9 @@ pub(crate) struct SphereArgs {
     /// value). Default: count bad pixels, warn once and treat them as 0.
     #[arg(long)]
     strict: bool,
-    /// Run K density-weighted Lloyd iterations on the set (about 3.5 s an
-    /// iteration for 10^6 points on two cores): spacing approaches a
+    /// Run K density-weighted Lloyd iterations on the set (about 1.5 s an
+    /// iteration for 10^6 points on two cores, 10-15 s for 10^7): spacing
+    /// approaches a
     /// centroidal Voronoi tessellation's, but prefixes are no longer
     /// progressive (every point moves) and the set no longer follows the
     /// density exactly, so the pdf column is the target density's.
