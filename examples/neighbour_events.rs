@@ -1,26 +1,29 @@
-//! What a table of neighbour events would give between the sphere's bins
-//! (a design measurement; the run time does not read such a table yet).
+//! What drop moves give between the sphere's bins, simulated in sphere
+//! coordinates: the measurement behind `lut::DropMoves`, and the way to
+//! weigh them on the levels that do not have them yet (5 and 6, which keep
+//! sibling fills: their moves would pass the 4 MB table budget).
 //!
 //! Between two bins a request keeps the codes below `N` of the upper
-//! bin's relaxed set, and each dropped point leaves a hole. The shipped
-//! table lets only the dropped point's siblings move (sibling fills).
-//! Here the builder's alternative is simulated: the upper bin's codes are
-//! dropped one at a time, highest first, as ever smaller requests drop
-//! them, and each drop relaxes (uniform Lloyd, among the other points
-//! held fixed) the kept points within `--reach` spacings of the dropped
-//! point or of any point dropped before it within `--hole` spacings. A
-//! point that moves records an event: its new place, keyed by the code
-//! whose drop moved it. A request of `N` would read, for each point, the
-//! event of the lowest code at or above `N`, so its set is exactly the
-//! simulation's state after dropping the codes from `N` up.
+//! bin's relaxed set, and each dropped point leaves a hole. Here the
+//! upper bin's codes are dropped one at a time, highest first, as ever
+//! smaller requests drop them, and each drop relaxes (uniform Lloyd,
+//! among the other points held fixed) the kept points within `--reach`
+//! spacings of the dropped point or of any point dropped before it within
+//! `--hole` spacings. A point that moves records an event: its new place,
+//! keyed by the code whose drop moved it. A request of `N` would read, for
+//! each point, the event of the lowest code at or above `N`, so its set
+//! is exactly the simulation's state after dropping the codes from `N`
+//! up. The table builder does the same in the tiles' frames, with a room
+//! and a guard (`optimize::sphere::drop_moves`).
 //!
 //! For each bin interval of a level it prints separation, covering and
 //! mesh ratio (times √N) at `--evaluate` counts spread over the interval,
-//! shipped table against events, then the level's worst, its events a
-//! tile and what they would take in a table (per tile, uncompressed and
-//! zstd: a count a tile, a 16- or 24-bit code and an `i8` pair a move, in
-//! 1/40 cell, per interval). Levels 4 and 5 share rows by ring on the
-//! shipped table, which would divide their event tables by about 4.
+//! the shipped table (drop moves on levels 0-4, sibling fills on 5-6)
+//! against the simulation, then the level's worst, its events a tile and
+//! what they would take in a table (per tile, uncompressed and zstd: a
+//! count a tile, a 16- or 24-bit code and an `i8` pair a move, in 1/40
+//! cell, per interval). Levels 4-6 share rows by ring on the shipped
+//! table, which divides their tables by about 4.
 //!
 //!     cargo run --release --example neighbour_events -- LEVEL [BIN ...]
 //!         [--reach 1.5] [--hole 2] [--iterations 5] [--prune 0.05] [--evaluate 3]
