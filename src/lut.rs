@@ -246,9 +246,9 @@ pub(crate) struct LevelOffsets<'a> {
     lut: &'a SphereLut,
     level: usize,
     table: &'a [[i8; 2]],
-    /// The level's drop moves in the bin, and the first key the request
-    /// drops.
-    moves: Option<(&'a DropMoves, u16)>,
+    /// The level's drop moves in the bin, the first key the request
+    /// drops, and whether a ring's faces share the level's rows.
+    moves: Option<(&'a DropMoves, u16, bool)>,
     /// The level's sibling fills, and the request's counts.
     fills: Option<(&'a [[i8; 2]], FillCounts)>,
 }
@@ -273,8 +273,7 @@ impl LevelOffsets<'_> {
     ) -> [f64; 2] {
         let row = self.lut.row(self.level, index);
         let moved = match (self.moves, &self.fills) {
-            (Some((moves, dropped_from)), _) => {
-                let ring = self.level >= self.lut.ring_from as usize;
+            (Some((moves, dropped_from, ring)), _) => {
                 moves.offset(row, dropped_from, ring.then_some((code & 3) as u8))
             }
             (None, Some((fills, counts))) => (counts.pair(code, shares_a_hole))
@@ -601,7 +600,8 @@ impl SphereLut {
                 let accepted = accepted_count(fraction, capacity) as u64;
                 let lower = self.bin_codes(bin - 1, capacity);
                 let dropped_from = accepted.saturating_sub(lower).min(u64::from(u16::MAX));
-                offsets.moves = Some((moves, dropped_from as u16));
+                let ring = level >= u32::from(self.ring_from);
+                offsets.moves = Some((moves, dropped_from as u16, ring));
             }
             None => {
                 let counts = self.fill_counts(level, fraction, capacity, bin);

@@ -206,6 +206,9 @@ impl<'a> BinDrops<'a> {
         if movable.is_empty() {
             return Vec::new();
         }
+        // how far apart the moved points must stay: the guard, or what
+        // they kept before
+        let least = (GUARD * spacing).min(nearest_pair(&points, &movable));
         relax_among_fixed(&mut points, &movable, ITERATIONS)
             .expect("the bin's points are unit vectors");
         let targets: Vec<[f64; 2]> = (movable.iter())
@@ -215,7 +218,7 @@ impl<'a> BinDrops<'a> {
         // room stopped short left another too close to it
         let Some((offsets, placed)) = (SHARES.iter())
             .map(|&share| self.moved_share(&around, &movable, &targets, share))
-            .find(|(_, placed)| self.clear(&around, &movable, placed, spacing))
+            .find(|(_, placed)| self.clear(&around, &movable, placed, least))
         else {
             return Vec::new();
         };
@@ -288,16 +291,14 @@ impl<'a> BinDrops<'a> {
             .unzip()
     }
 
-    /// Whether the points `placed` (the movable ones') keep [`GUARD`]
-    /// spacings from every other point about the hole, or at least the
-    /// distance they kept before.
-    fn clear(&self, around: &[usize], movable: &[usize], placed: &[DVec3], spacing: f64) -> bool {
+    /// Whether the points `placed` (the movable ones') keep `least` from
+    /// every other point about the hole.
+    fn clear(&self, around: &[usize], movable: &[usize], placed: &[DVec3], least: f64) -> bool {
         let mut points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
-        let before = nearest_pair(&points, movable);
         for (&k, &p) in movable.iter().zip(placed) {
             points[k] = p;
         }
-        nearest_pair(&points, movable) >= (GUARD * spacing).min(before)
+        nearest_pair(&points, movable) >= least
     }
 
     /// The point of `code`'s tile at stored offset `offset`.
