@@ -672,24 +672,24 @@ impl SphereLut {
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// // level 5, the first with sibling fills; 61,440 parents
-    /// assert_eq!(lut.drop_moves.len(), 5);
-    /// let capacity = 245_760.0;
-    /// let fraction = 83_200.0 / capacity;
+    /// // level 6, the one with sibling fills; 245,760 parents
+    /// assert_eq!(lut.drop_moves.len(), 6);
+    /// let capacity = 983_040.0;
+    /// let fraction = 332_800.0 / capacity;
     /// let bin = lut.bin(fraction, capacity);
-    /// // bin 3 keeps codes below 89,671, so the parent of code 86,400
-    /// // (86,400 - 61,440 = 24,960) lacks its digit-1 child; its digit-0
-    /// // child, code 24,960, fills in
+    /// // bin 3 keeps codes below 358,682, so the parent of code 345,760
+    /// // (345,760 - 245,760 = 100,000) lacks its digit-1 child; its digit-0
+    /// // child, code 100,000, fills in
     /// let apart = |_| false;
-    /// assert_eq!(lut.fill_pair(24_960, 5, fraction, bin, capacity, apart), Some(0));
+    /// assert_eq!(lut.fill_pair(100_000, 6, fraction, bin, capacity, apart), Some(0));
     /// // the parent of code 18,624 keeps both children the bin has
-    /// assert_eq!(lut.fill_pair(18_624, 5, fraction, bin, capacity, apart), None);
-    /// // keeping codes below 86,402 keeps 86,400 and 86,401, twins of
-    /// // code 86,402: a fill next to a pole assumed them missing
-    /// let fraction = 86_402.0 / capacity;
+    /// assert_eq!(lut.fill_pair(18_624, 6, fraction, bin, capacity, apart), None);
+    /// // keeping codes below 345,762 keeps 345,760 and 345,761, twins of
+    /// // code 345,762: a fill next to a pole assumed them missing
+    /// let fraction = 345_762.0 / capacity;
     /// let bin = lut.bin(fraction, capacity);
-    /// assert_eq!(lut.fill_pair(24_962, 5, fraction, bin, capacity, apart), Some(0));
-    /// assert_eq!(lut.fill_pair(24_962, 5, fraction, bin, capacity, |_| true), None);
+    /// assert_eq!(lut.fill_pair(100_002, 6, fraction, bin, capacity, apart), Some(0));
+    /// assert_eq!(lut.fill_pair(100_002, 6, fraction, bin, capacity, |_| true), None);
     /// // the levels with drop moves have none
     /// assert_eq!(lut.fill_pair(390, 2, 1300.0 / 3840.0, 3, 3840.0, apart), None);
     /// ```
@@ -734,7 +734,7 @@ impl SphereLut {
     /// # Example
     /// ```
     /// let lut = tessera::lut::sphere_lut();
-    /// let o = lut.fill(5, 0, 0);
+    /// let o = lut.fill(6, 0, 0);
     /// assert!((-1.0..=3.0).contains(&o[0]) && (-1.0..=4.0).contains(&o[1]));
     /// ```
     pub fn fill(&self, level: usize, parent: usize, pair: usize) -> [f64; 2] {

@@ -402,7 +402,7 @@ fn seeds_randomise_every_density_and_the_plane_writes_pdfs() {
 fn relax_evens_the_set_and_refuses_a_window() {
     let mesh = |relax: &str| -> f64 {
         let out = tessera(&[
-            "sphere", "-n", "20000", "--relax", relax, "--report", "-o", "-",
+            "sphere", "-n", "300000", "--relax", relax, "--report", "-o", "-",
         ]);
         assert!(out.status.success());
         assert_eq!(
@@ -410,14 +410,15 @@ fn relax_evens_the_set_and_refuses_a_window() {
                 .lines()
                 .filter(|l| !l.starts_with('#'))
                 .count(),
-            20000
+            300_000
         );
         let report = String::from_utf8_lossy(&out.stderr).to_string();
         let ratio = report.split("mesh ratio ").nth(1).expect("a report");
         ratio.trim().parse().expect("a number")
     };
     // ten iterations bring a set near a CVT's (docs/SPHERE_SWEEP.md: mesh
-    // ratio at most 2.10 over 52 counts after 10)
+    // ratio at most 2.20 over 69 counts after 10); between bins on level
+    // 6, where the holes stay open (mesh ratio 2.99 here)
     let (before, after) = (mesh("0"), mesh("10"));
     assert!(after < 0.8 * before && after < 2.2, "{before} -> {after}");
     let out = tessera(&["sphere", "-n", "100", "--within", "0,0,10", "--relax", "2"]);

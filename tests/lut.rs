@@ -114,18 +114,27 @@ fn the_shipped_tables_fit_in_4_mb() {
     assert!(total < 4_000_000, "{sizes:?}: {total} bytes");
 }
 
-/// The last per-tile level's offsets and fills lie on the build's coarser
-/// grid (`BuildOptions::deep_tile_step`, 2), which is what keeps the
-/// sphere table within the budget.
+/// The last per-tile level's offsets, fills and drop moves lie on the
+/// build's coarser grid (`BuildOptions::deep_tile_step`, 4), the level
+/// above on one half as coarse, which is what keeps the sphere table
+/// within the budget.
 #[test]
-fn the_last_per_tile_level_lies_on_the_coarser_grid() {
+fn the_last_per_tile_levels_lie_on_coarser_grids() {
     let lut = sphere_lut();
-    let level = lut.exact_levels as usize - 1;
-    let even = |pairs: &[[i8; 2]]| pairs.iter().flatten().all(|v| v % 2 == 0);
-    for (bin, table) in lut.tables[level].iter().enumerate() {
-        assert!(even(table), "level {level} bin {bin}");
+    let on = |step: i8| move |pairs: &[[i8; 2]]| pairs.iter().flatten().all(|v| v % step == 0);
+    let last = lut.exact_levels as usize - 1;
+    for (level, step) in [(last, 4), (last - 1, 2)] {
+        for (bin, table) in lut.tables[level].iter().enumerate() {
+            assert!(on(step)(table), "level {level} bin {bin}");
+        }
+        // the level's fills (if it has them) and drop moves
+        let fills = lut.fills.get(level).map_or(&[][..], |f| &f[..]);
+        assert!(on(step)(fills), "fills of level {level}");
+        for (bin, moves) in lut.drop_moves.get(level).into_iter().flatten().enumerate() {
+            let offsets: Vec<[i8; 2]> = moves.iter().map(|(_, _, offset)| offset).collect();
+            assert!(on(step)(&offsets), "drop moves of level {level} bin {bin}");
+        }
+        // and the level above is finer
+        assert!(!on(step)(&lut.tables[level - 1][0]), "level {}", level - 1);
     }
-    assert!(even(&lut.fills[level]), "fills of level {level}");
-    // the level above keeps the table's full resolution
-    assert!(!even(&lut.tables[level - 1][0]));
 }

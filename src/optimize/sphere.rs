@@ -65,8 +65,8 @@ pub struct BuildOptions {
     pub fill_levels: u8,
     /// Levels `0..drop_move_levels` get drop moves (see
     /// [`crate::lut::DropMoves`]) in place of sibling fills. Their keys
-    /// are 16 bits wide, which holds the bins of levels 0-5; level 5's
-    /// moves (879 kB) would take the sphere table past the 4 MB budget.
+    /// are 16 bits wide, which holds the bins of levels 0-5; level 6's
+    /// moves, four times level 5's 640 kB, would not fit the 4 MB budget.
     pub drop_move_levels: u8,
     /// First level whose neighbourhood classes are enumerated and relaxed,
     /// below `exact_levels`: each class level relaxes from the one above,
@@ -86,12 +86,16 @@ pub struct BuildOptions {
     /// `class_depth`: its rows start from their classes' offsets, which
     /// already fit, so a few iterations refit each to its own tile.
     pub deep_tile_iterations: usize,
-    /// The last tree-indexed level's offsets and sibling fills lie on a
-    /// grid this many times coarser than the table's 1/40 cell: at 2, zstd
-    /// stores the level's 5.9 MB of pairs in 392 kB less (a tenth of the
-    /// 4 MB budget of every table), and the covering radius of 51 counts
-    /// on that level moved by at most 0.03 / sqrt(N), 3.687 -> 3.684 on
-    /// average (`tessera sphere -n N --table T --report`, both tables).
+    /// The last tree-indexed level's offsets, sibling fills and drop
+    /// moves lie on a grid this many times coarser than the table's 1/40
+    /// cell, the level above on one half as coarse, and so on up to the
+    /// table's own. Level 6 at 2 (a 1/20 cell) stored its 5.9 MB of pairs
+    /// in 392 kB less than at 1, the covering radius of 51 counts on it
+    /// moving by at most 0.03 / sqrt(N). At 4, level 6's offsets and
+    /// fills took 479 kB less again and level 5's offsets (at 2) 86 kB
+    /// less, which made room for level 5's drop moves in the 4 MB budget;
+    /// level 6's mean covering radius went 3.075 -> 3.055 / sqrt(N) at its
+    /// 5 bins' counts and 3.905 -> 3.920 at 14 counts between them.
     pub deep_tile_step: u8,
     /// Separation steps per table level and bin, after Lloyd.
     pub separation_steps: usize,
@@ -107,12 +111,13 @@ pub struct BuildOptions {
 }
 
 impl BuildOptions {
-    /// The grid step, in the table's 1/40 cells, of `level`'s offsets and
-    /// fills (see [`BuildOptions::deep_tile_step`]).
+    /// The grid step, in the table's 1/40 cells, of `level`'s offsets,
+    /// fills and drop moves (see [`BuildOptions::deep_tile_step`]).
     fn grid_step(&self, level: u32) -> u8 {
-        match level + 1 == u32::from(self.exact_levels) {
-            true => self.deep_tile_step,
-            false => 1,
+        let above_last = u32::from(self.exact_levels).checked_sub(level + 1);
+        match above_last {
+            Some(levels) if levels < 8 => (self.deep_tile_step >> levels).max(1),
+            _ => 1,
         }
     }
 }
@@ -125,14 +130,14 @@ impl Default for BuildOptions {
             exact_levels: 7,
             ring_from: 4,
             fill_levels: 7,
-            drop_move_levels: 5,
+            drop_move_levels: 6,
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
             bins: 12,
             iterations: 32,
             deep_tile_iterations: 8,
-            deep_tile_step: 2,
+            deep_tile_step: 4,
             separation_steps: 40,
             class_separation_depth: 1,
             closure_levels: 1,

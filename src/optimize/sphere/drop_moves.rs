@@ -30,29 +30,35 @@ const HOLE: f64 = 2.0;
 const AROUND: f64 = 5.5;
 /// Lloyd iterations a drop.
 const ITERATIONS: usize = 5;
+/// A point its room stops this many spacings short of its relaxed place
+/// is pinned where the room lets it go, and the others relax again (see
+/// `BinDrops::relax_within_room`).
+const STOPPED: f64 = 0.1;
+/// Rounds of pinning a drop, at most.
+const PIN_ROUNDS: usize = 2;
 /// A move shorter than this many spacings is neither made nor stored,
-/// which keeps the table small.
-const SHORTEST: f64 = 0.05;
+/// per level, which keeps the table small: level 5's moves took 811 kB
+/// at 0.05 and 640 kB at 0.10, and over 20 counts between its bins the
+/// covering radius moved from 3.09 to 3.11 / sqrt(N) on average (worst
+/// 3.32 and 3.27).
+const SHORTEST: [f64; 6] = [0.05, 0.05, 0.05, 0.05, 0.05, 0.10];
 
 /// Shares of the way to their relaxed places the moves of one drop go,
 /// the first that keeps the points [`GUARD`] apart winning.
 const SHARES: [f64; 5] = [1.0, 0.75, 0.5, 0.25, 0.0];
-/// Spacings a moved point keeps from every other (or what it kept before):
-/// a point the room stops short can leave a neighbour, relaxed as if it
-/// had gone all the way, too close (N = 6769: 2.13 / sqrt(N) without the
-/// guard). At 0.75 the moves of four counts stopped short of their holes
-/// (covering 3.45-3.68).
+/// Spacings (at the bin's lowest count, the densest set a pair made at
+/// any drop of the bin stays in) a moved point keeps from every other, or
+/// what it kept before: a point the room stops short can leave a
+/// neighbour too close (N = 6769: 2.13 / sqrt(N) without the guard).
+/// Measured at the spacing of the drop, a pair made at the bin's top
+/// count read 2.39 at N = 120,000.
 const GUARD: f64 = 0.70;
 
-/// The distance from each of `points[movable]` to its nearest other point,
-/// least.
-fn nearest_pair(points: &[DVec3], movable: &[usize]) -> f64 {
-    (movable.iter())
-        .flat_map(|&k| {
-            (0..points.len())
-                .filter(move |&j| j != k)
-                .map(move |j| points[k].distance(points[j]))
-        })
+/// The distance from `points[k]` to its nearest other point.
+fn nearest(points: &[DVec3], k: usize) -> f64 {
+    (0..points.len())
+        .filter(|&j| j != k)
+        .map(|j| points[k].distance(points[j]))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -94,6 +100,8 @@ struct BinDrops<'a> {
     /// codes (equal but for the last two bits) drop together.
     ring: bool,
     step: u8,
+    /// The [`GUARD`] distance.
+    guard: f64,
     /// Where a moved point may lie: the tile grown by three cells (and
     /// the `i8` range). Grown by one, the room of the bin's offsets,
     /// N = 4954 read separation 2.35 and covering 3.41; by two, 20,188
@@ -132,6 +140,7 @@ impl<'a> BinDrops<'a> {
             bin,
             lower,
             ring: lut.rows(level) < by_code.len(),
+            guard: GUARD * (4.0 * PI / lower.max(1) as f64).sqrt(),
             step,
             room: tiling.shape().dilated().dilated().dilated(),
             tree,
@@ -196,49 +205,25 @@ impl<'a> BinDrops<'a> {
             .collect();
         around.sort_unstable();
         around.dedup();
-        let mut points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
+        let start: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let movable: Vec<usize> = (0..around.len())
-            .filter(|&k| {
-                hole.iter()
-                    .any(|h| points[k].distance(*h) < REACH * spacing)
-            })
+            .filter(|&k| hole.iter().any(|h| start[k].distance(*h) < REACH * spacing))
             .collect();
         if movable.is_empty() {
             return Vec::new();
         }
-        // how far apart the moved points must stay: the guard, or what
-        // they kept before
-        let least = (GUARD * spacing).min(nearest_pair(&points, &movable));
-        relax_among_fixed(&mut points, &movable, ITERATIONS)
-            .expect("the bin's points are unit vectors");
-        let targets: Vec<[f64; 2]> = (movable.iter())
-            .map(|&k| self.local_for(around[k], points[k]))
-            .collect();
+        let (movable, targets) = self.relax_within_room(&around, &start, movable, spacing);
+        let shortest = SHORTEST[self.level] * spacing;
         // the moves all the way, or a share of the way where a point the
         // room stopped short left another too close to it
-        let Some((offsets, placed)) = (SHARES.iter())
-            .map(|&share| self.moved_share(&around, &movable, &targets, share))
-            .find(|(_, placed)| self.clear(&around, &movable, placed, least))
+        let Some(moves) = (SHARES.iter())
+            .map(|&share| self.share_moves(&around, &movable, &targets, share, shortest))
+            .find(|moves| self.clear(&around, &start, moves, kept))
         else {
             return Vec::new();
         };
-        // one move a row: a ring's twins moved alike, the lowest code's kept
-        let mut moves: Vec<(usize, usize, [i8; 2])> = (movable.iter().zip(offsets).zip(placed))
-            .filter(|&((&k, _), p)| p.distance(self.current[around[k]]) >= SHORTEST * spacing)
-            .map(|((&k, offset), _)| {
-                let code = around[k];
-                let row = self.lut.row(self.level, self.by_code[code].index as usize);
-                (row, code, offset)
-            })
-            .collect();
-        moves.sort_unstable_by_key(|&(row, code, _)| (row, code));
-        moves.dedup_by_key(|m| m.0);
         for &(_, code, offset) in &moves {
-            let twins = match self.ring {
-                true => (code & !3..(code | 3) + 1).filter(|&c| c < kept).collect(),
-                false => vec![code],
-            };
-            for twin in twins {
+            for twin in self.twins(code, kept) {
                 self.stored[twin] = offset;
                 self.current[twin] = self.place(twin, offset);
             }
@@ -257,6 +242,57 @@ impl<'a> BinDrops<'a> {
             .collect()
     }
 
+    /// Relaxes `movable` (indices into `around`, at `start`) among the
+    /// others and returns the points that move with their target offsets.
+    /// A point its room stops short of its place is pinned where the room
+    /// lets it go, and the rest relax again around it: relaxed as if it
+    /// had gone all the way, they left its side of the hole open (N =
+    /// 70,381: a point 4 cells from its tile, covering 3.49 / sqrt(N)).
+    fn relax_within_room(
+        &self,
+        around: &[usize],
+        start: &[DVec3],
+        mut movable: Vec<usize>,
+        spacing: f64,
+    ) -> (Vec<usize>, Vec<[f64; 2]>) {
+        let mut pinned: Vec<(usize, [f64; 2])> = Vec::new();
+        for round in 0..=PIN_ROUNDS {
+            let mut points = start.to_vec();
+            for &(k, target) in &pinned {
+                points[k] = self
+                    .tiling
+                    .face_point(&self.by_code[around[k]], target)
+                    .to_vec();
+            }
+            relax_among_fixed(&mut points, &movable, ITERATIONS)
+                .expect("the bin's points are unit vectors");
+            let targets: Vec<[f64; 2]> = (movable.iter())
+                .map(|&k| self.local_for(around[k], points[k]))
+                .collect();
+            let stopped = |(&k, target): (&usize, &[f64; 2])| {
+                let at = self
+                    .tiling
+                    .face_point(&self.by_code[around[k]], *target)
+                    .to_vec();
+                at.distance(points[k]) > STOPPED * spacing
+            };
+            if round == PIN_ROUNDS || !movable.iter().zip(&targets).any(stopped) {
+                let (mut moved, mut to): (Vec<usize>, Vec<[f64; 2]>) = pinned.into_iter().unzip();
+                moved.extend(movable);
+                to.extend(targets);
+                return (moved, to);
+            }
+            let (stuck, free): (Vec<_>, Vec<_>) = movable
+                .iter()
+                .copied()
+                .zip(targets)
+                .partition(|(k, t)| stopped((k, t)));
+            pinned.extend(stuck);
+            movable = free.into_iter().map(|(k, _)| k).collect();
+        }
+        unreachable!("the last round returns")
+    }
+
     /// The offset (tile frame, inside the tile's room) whose point is
     /// nearest `target`.
     fn local_for(&self, code: usize, target: DVec3) -> [f64; 2] {
@@ -271,34 +307,68 @@ impl<'a> BinDrops<'a> {
         within_room(&self.room, bin_offset, local)
     }
 
-    /// The movable points' stored offsets `share` of the way from where
-    /// they are to `targets`, and their points.
-    fn moved_share(
+    /// The moves `share` of the way from where the movable points are to
+    /// their `targets`: one a row, `(row, code, offset)`, a ring's twins
+    /// moving alike (the lowest moving code's). A point that would move
+    /// less than `shortest` stays, as the table will not store its move.
+    fn share_moves(
         &self,
         around: &[usize],
         movable: &[usize],
         targets: &[[f64; 2]],
         share: f64,
-    ) -> (Vec<[i8; 2]>, Vec<DVec3>) {
-        (movable.iter().zip(targets))
-            .map(|(&k, target)| {
+        shortest: f64,
+    ) -> Vec<(usize, usize, [i8; 2])> {
+        let mut moves: Vec<(usize, usize, [i8; 2])> = (movable.iter().zip(targets))
+            .filter_map(|(&k, target)| {
                 let code = around[k];
                 let from = dequantise(self.stored[code]);
                 let to = [0, 1].map(|c| from[c] + share * (target[c] - from[c]));
                 let offset = SphereLut::quantise_on(to, self.step);
-                (offset, self.place(code, offset))
+                let moved = self.place(code, offset).distance(self.current[code]);
+                let row = self.lut.row(self.level, self.by_code[code].index as usize);
+                (moved >= shortest).then_some((row, code, offset))
             })
-            .unzip()
+            .collect();
+        moves.sort_unstable_by_key(|&(row, code, _)| (row, code));
+        moves.dedup_by_key(|m| m.0);
+        moves
     }
 
-    /// Whether the points `placed` (the movable ones') keep `least` from
-    /// every other point about the hole.
-    fn clear(&self, around: &[usize], movable: &[usize], placed: &[DVec3], least: f64) -> bool {
-        let mut points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
-        for (&k, &p) in movable.iter().zip(placed) {
-            points[k] = p;
+    /// The codes a move of `code` places: its ring twins still kept, or
+    /// itself.
+    fn twins(&self, code: usize, kept: usize) -> Vec<usize> {
+        match self.ring {
+            true => (code & !3..(code | 3) + 1).filter(|&c| c < kept).collect(),
+            false => vec![code],
         }
-        nearest_pair(&points, movable) >= least
+    }
+
+    /// Whether every point `moves` place keeps the guard, or what it kept
+    /// before at `start`, from every other point about the hole: checked
+    /// on the points as the table will place them (a point whose move was
+    /// too short to store, checked as moved, let a neighbour come within
+    /// 2.36 / sqrt(N) of it at N = 120,000).
+    fn clear(
+        &self,
+        around: &[usize],
+        start: &[DVec3],
+        moves: &[(usize, usize, [i8; 2])],
+        kept: usize,
+    ) -> bool {
+        let mut points = start.to_vec();
+        let mut moved = Vec::new();
+        for &(_, code, offset) in moves {
+            for twin in self.twins(code, kept) {
+                // `around` is sorted; a twin outside it cannot be checked
+                let Ok(k) = around.binary_search(&twin) else {
+                    return false;
+                };
+                points[k] = self.place(twin, offset);
+                moved.push(k);
+            }
+        }
+        (moved.iter()).all(|&k| nearest(&points, k) >= self.guard.min(nearest(start, k)))
     }
 
     /// The point of `code`'s tile at stored offset `offset`.
