@@ -18,7 +18,7 @@
 //!
 //! For each bin interval of a level it prints separation, covering and
 //! mesh ratio (times √N) at `--evaluate` counts spread over the interval,
-//! the shipped table (drop moves on levels 0-4, sibling fills on 5-6)
+//! the shipped table (drop moves on levels 0-5, sibling fills on 6)
 //! against the simulation, then the level's worst, its events a tile and
 //! what they would take in a table (per tile, uncompressed and zstd: a
 //! count a tile, a 16- or 24-bit code and an `i8` pair a move, in 1/40
