@@ -155,11 +155,11 @@ fn a_window_returns_exactly_the_full_sets_samples_in_it() {
 
 #[test]
 fn windows_find_the_points_that_drop_moves_carried_out_of_their_tiles() {
-    // between bins on levels 0-4 a point beside a dropped code may move up
+    // between bins on levels 0-5 a point beside a dropped code may move up
     // to three cells past its tile; a window visits the tiles reaching it
     // and must still find every such point, at poles and seams too
     let tiling = SphereTiling::default();
-    for n in [3000.0, 20_188.0] {
+    for n in [3000.0, 20_188.0, 120_000.0] {
         let all = engine::collect(&tiling, &Uniform, n);
         for k in 0..100 {
             let lon = (k as f64 * 137.508) % 360.0 - 180.0;
