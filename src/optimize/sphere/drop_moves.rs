@@ -259,36 +259,30 @@ impl<'a> BinDrops<'a> {
         for round in 0..=PIN_ROUNDS {
             let mut points = start.to_vec();
             for &(k, target) in &pinned {
-                points[k] = self
-                    .tiling
-                    .face_point(&self.by_code[around[k]], target)
-                    .to_vec();
+                points[k] = self.point_at(around[k], target);
             }
             relax_among_fixed(&mut points, &movable, ITERATIONS)
                 .expect("the bin's points are unit vectors");
             let targets: Vec<[f64; 2]> = (movable.iter())
                 .map(|&k| self.local_for(around[k], points[k]))
                 .collect();
-            let stopped = |(&k, target): (&usize, &[f64; 2])| {
-                let at = self
-                    .tiling
-                    .face_point(&self.by_code[around[k]], *target)
-                    .to_vec();
-                at.distance(points[k]) > STOPPED * spacing
-            };
-            if round == PIN_ROUNDS || !movable.iter().zip(&targets).any(stopped) {
+            let stuck: Vec<bool> = (movable.iter().zip(&targets))
+                .map(|(&k, &t)| self.point_at(around[k], t).distance(points[k]) > STOPPED * spacing)
+                .collect();
+            if round == PIN_ROUNDS || !stuck.contains(&true) {
                 let (mut moved, mut to): (Vec<usize>, Vec<[f64; 2]>) = pinned.into_iter().unzip();
                 moved.extend(movable);
                 to.extend(targets);
                 return (moved, to);
             }
-            let (stuck, free): (Vec<_>, Vec<_>) = movable
-                .iter()
-                .copied()
-                .zip(targets)
-                .partition(|(k, t)| stopped((k, t)));
-            pinned.extend(stuck);
-            movable = free.into_iter().map(|(k, _)| k).collect();
+            let mut free = Vec::new();
+            for ((k, target), stuck) in movable.into_iter().zip(targets).zip(stuck) {
+                match stuck {
+                    true => pinned.push((k, target)),
+                    false => free.push(k),
+                }
+            }
+            movable = free;
         }
         unreachable!("the last round returns")
     }
@@ -299,7 +293,7 @@ impl<'a> BinDrops<'a> {
         let tile = &self.by_code[code];
         let mut local = dequantise(self.stored[code]);
         for _ in 0..3 {
-            let site = self.tiling.face_point(tile, local).to_vec();
+            let site = self.point_at(code, local);
             local = to_local(self.tiling, tile, local, site, target);
         }
         let row = self.lut.row(self.level, tile.index as usize);
@@ -373,8 +367,11 @@ impl<'a> BinDrops<'a> {
 
     /// The point of `code`'s tile at stored offset `offset`.
     fn place(&self, code: usize, offset: [i8; 2]) -> DVec3 {
-        self.tiling
-            .face_point(&self.by_code[code], dequantise(offset))
-            .to_vec()
+        self.point_at(code, dequantise(offset))
+    }
+
+    /// The point of `code`'s tile at offset `local` (tile frame, cells).
+    fn point_at(&self, code: usize, local: [f64; 2]) -> DVec3 {
+        self.tiling.face_point(&self.by_code[code], local).to_vec()
     }
 }
