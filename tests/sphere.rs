@@ -444,14 +444,16 @@ fn ring_shared_levels_leave_no_hole_at_the_common_counts() {
     // levels 4-6 share rows between a ring's four faces; a common
     // fraction's set (powers of two, 3 * 2^k, HEALPix's 12 * 4^k) must be
     // the same on each face, or the shared offsets leave holes (N = 49,152
-    // read covering 3.56 while root ranks split the ring orbits)
+    // read covering 3.56 while root ranks split the ring orbits); since
+    // the bins are coupled (so that adaptive sets do not crowd where the
+    // bin changes) these counts read 2.91-3.23, 2.83-3.06 before
     use tessera::metrics::sphere::covering_radius;
     for n in [
         16_384, 24_576, 32_768, 49_152, 65_536, 98_304, 131_072, 196_608, 262_144, 393_216,
         524_288, 786_432,
     ] {
         let covering = covering_radius(&uniform_points(n));
-        assert!(covering <= 3.2, "N = {n}: covering {covering:.3}");
+        assert!(covering <= 3.3, "N = {n}: covering {covering:.3}");
     }
 }
 
