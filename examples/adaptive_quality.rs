@@ -24,14 +24,13 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
-use std::num::NonZero;
 use std::time::Instant;
 use tessera::baselines::spherical_fibonacci;
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::density::region::Regions;
 use tessera::density::Density;
 use tessera::healpix::lonlat_to_vec;
-use tessera::metrics::sphere::geodesic_distance;
+use tessera::metrics::sphere::{geodesic_distance, nearest_angles};
 use tessera::synth::Sky;
 use tessera::tiling::sphere::SphereRegion;
 use tessera::Sampler;
@@ -223,21 +222,6 @@ fn map_case(sky: Sky) -> Case {
 fn tree(points: &[DVec3]) -> ImmutableKdTree<f64, 3> {
     let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
     ImmutableKdTree::new_from_slice(&coords)
-}
-
-/// The angle from each point to its nearest other point.
-fn nearest_angles(points: &[DVec3]) -> Vec<f64> {
-    let tree = tree(points);
-    let two = NonZero::new(2).expect("2 > 0");
-    points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let found = tree.nearest_n::<SquaredEuclidean>(&p.to_array(), two);
-            let j = found.iter().map(|f| f.item as usize).find(|&j| j != i);
-            geodesic_distance(*p, points[j.expect("at least two points")])
-        })
-        .collect()
 }
 
 /// A sample's size, 1st percentile and median (nearest rank; NaN when

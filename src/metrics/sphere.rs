@@ -72,6 +72,27 @@ fn nearest_other(tree: &Tree3, points: &[DVec3], i: usize) -> usize {
         .expect("a tree of at least two points returns another point")
 }
 
+/// The geodesic angle from each point to its nearest other point (+∞ for
+/// a single point), by a k-d tree: O(N log N), parallel.
+///
+/// ```
+/// use glam::DVec3;
+/// use tessera::metrics::sphere::nearest_angles;
+/// let angles = nearest_angles(&[DVec3::X, DVec3::Y, DVec3::NEG_X]);
+/// assert!((angles[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+/// assert_eq!(nearest_angles(&[DVec3::Z]), vec![f64::INFINITY]);
+/// ```
+pub fn nearest_angles(points: &[DVec3]) -> Vec<f64> {
+    if points.len() < 2 {
+        return vec![f64::INFINITY; points.len()];
+    }
+    let tree = build_tree(points);
+    (0..points.len())
+        .into_par_iter()
+        .map(|i| geodesic_distance(points[i], points[nearest_other(&tree, points, i)]))
+        .collect()
+}
+
 /// Normalised separation `√N · min_{i≠j} d(x_i, x_j)` (geodesic).
 ///
 /// Each point's nearest neighbour is found with a k-d tree on the 3-D

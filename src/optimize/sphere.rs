@@ -1435,7 +1435,7 @@ fn seam_percentile(
                 scales.push((kept as f64).sqrt());
             }
         }
-        let mut spacings: Vec<f64> = nearest_angles(&sites)
+        let mut spacings: Vec<f64> = crate::metrics::sphere::nearest_angles(&sites)
             .iter()
             .zip(&scales)
             .map(|(angle, scale)| angle * scale)
@@ -1444,24 +1444,6 @@ fn seam_percentile(
         total += spacings[spacings.len() / 100];
     }
     total / (bins - 1) as f64
-}
-
-/// The angle from each site to its nearest other site.
-fn nearest_angles(sites: &[DVec3]) -> Vec<f64> {
-    let tree = site_tree(sites);
-    let skew = skew();
-    let two = std::num::NonZero::new(2).expect("2 > 0");
-    sites
-        .par_iter()
-        .enumerate()
-        .map(|(i, site)| {
-            let found = tree.nearest_n::<SquaredEuclidean>(&(skew * *site).to_array(), two);
-            let other = found.iter().map(|f| f.item as usize).find(|&j| j != i);
-            other.map_or(f64::INFINITY, |j| {
-                crate::metrics::sphere::geodesic_distance(*site, sites[j])
-            })
-        })
-        .collect()
 }
 
 /// Lloyd iterations for one level and one importance bin; returns the new
