@@ -477,6 +477,22 @@ fn uniform_sets_meet_the_quality_floors_against_fibonacci() {
 }
 
 #[test]
+fn cap_discrepancy_meets_issue_18s_floor_where_farthest_point_root_ranks_failed() {
+    // the sweep's counts under 10^4 that read 1.31-1.88 times Fibonacci's
+    // with the roots in farthest-point order (their kept tiles' zonal
+    // moments; DESIGN.md, root ranks)
+    use tessera::metrics::sphere::cap_discrepancy_l2;
+    for n in [160, 187, 218, 349, 890, 1421, 1661, 2270, 3101] {
+        let ours = cap_discrepancy_l2(&uniform_points(n));
+        let ratio = ours / cap_discrepancy_l2(&tessera::baselines::spherical_fibonacci(n));
+        assert!(
+            ratio <= 1.3,
+            "N = {n}: cap discrepancy {ratio:.3}x Fibonacci's"
+        );
+    }
+}
+
+#[test]
 fn counts_are_exact_for_awkward_n() {
     for n in [0usize, 1, 2, 3, 239, 241, 1001, 4097] {
         assert_eq!(Sampler::sphere().count(n).generate().unwrap().len(), n);
