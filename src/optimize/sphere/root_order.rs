@@ -31,6 +31,10 @@ use std::sync::Arc;
 
 /// Zonal harmonics the objective weighs (their weights fall as `1/l²`).
 const DEGREES: usize = 8;
+/// `P_1..P_DEGREES` summed over some tiles.
+type Moments = [f64; DEGREES];
+/// A level and a count's quotient by 240.
+type Quotient = (usize, usize);
 /// Counts the objective samples, log-spaced from 100 to [`COUNTS_UP_TO`].
 const SAMPLES: usize = 600;
 /// Largest count the objective samples (issue 18's discrepancy floor).
@@ -147,9 +151,9 @@ fn spread(angles: &[Vec<f64>], orbits: &[usize]) -> Vec<f64> {
 /// with `M_l` the sum of `P_l(z)` over the kept centroids.
 struct ZonalModel {
     /// `tile[level][q][root]`: `P_1..P_DEGREES` of tile `m = q`'s centroid.
-    tile: Vec<Vec<Vec<[f64; DEGREES]>>>,
+    tile: Vec<Vec<Vec<Moments>>>,
     /// `below[level][q]`: the moments of every root's tiles `m < q`.
-    below: Vec<Vec<[f64; DEGREES]>>,
+    below: Vec<Vec<Moments>>,
     /// Sampled counts: (N, level, q, s).
     counts: Vec<(usize, usize, usize, usize)>,
 }
@@ -163,7 +167,7 @@ impl ZonalModel {
         let (mut tile, mut below) = (Vec::new(), Vec::new());
         for level in 0..=levels {
             let quotients = (1usize << (2 * level)).min(q_max + 1);
-            let rows: Vec<Vec<[f64; DEGREES]>> = (0..quotients)
+            let rows: Vec<Vec<Moments>> = (0..quotients)
                 .into_par_iter()
                 .map(|q| {
                     (0..ROOT_COUNT)
@@ -216,7 +220,8 @@ impl ZonalModel {
         let roots: Vec<usize> = (orbits.iter())
             .flat_map(|&o| [0, 2, 1, 3].map(|k| member(o, k)))
             .collect();
-        let mut prefix: Option<((usize, usize), Vec<[f64; DEGREES]>)> = None;
+        // the prefix sums over the ranks of the last (level, q) met
+        let mut prefix: Option<(Quotient, Vec<Moments>)> = None;
         let mut total = 0.0;
         for &(n, level, q, s) in &self.counts {
             let mut moments = self.below[level][q];
@@ -248,21 +253,21 @@ impl ZonalModel {
     }
 }
 
-fn add(a: &mut [f64; DEGREES], b: &[f64; DEGREES]) {
+fn add(a: &mut Moments, b: &Moments) {
     for (x, y) in a.iter_mut().zip(b) {
         *x += y;
     }
 }
 
 /// `P_1(z)..P_DEGREES(z)` by Bonnet's recursion.
-fn legendre(z: f64) -> [f64; DEGREES] {
-    let mut out = [0.0; DEGREES];
+fn legendre(z: f64) -> Moments {
+    let mut out: Moments = [0.0; DEGREES];
     let (mut previous, mut current) = (1.0, z);
     out[0] = z;
-    for l in 1..DEGREES {
+    for (l, slot) in out.iter_mut().enumerate().skip(1) {
         let next = ((2 * l + 1) as f64 * z * current - l as f64 * previous) / (l + 1) as f64;
         (previous, current) = (current, next);
-        out[l] = current;
+        *slot = current;
     }
     out
 }
