@@ -21,6 +21,7 @@ requests=(
   "sphere -n 10000000"
   "sphere -n 50000"
   "sphere -n 200000"
+  "sphere -n 240000"
   "sphere -n 600000"
   "sphere -n 1000"
   "sphere --map $work/maps/clear-sky_1024x512_f32.exr -n 1000000"

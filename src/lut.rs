@@ -37,7 +37,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 8;
+pub const SPHERE_LUT_VERSION: u32 = 9;
 
 /// zstd level sphere tables are written with: the highest, as a table is
 /// written once and read at every start (decoding speed does not depend on
@@ -121,13 +121,14 @@ pub struct SphereLut {
     /// [`SphereLut::fill_pair`]): a request between two bins keeps a prefix
     /// of the upper bin's set, and where that drops one child of a parent,
     /// its lower siblings take these offsets, relaxed with it missing and
-    /// every other point of the bin in place. Levels with drop moves have
-    /// none (an empty table).
+    /// every other point of the bin in place. Levels whose drop moves
+    /// replace them have none (an empty table).
     pub fills: Vec<Offsets>,
     /// Drop moves of the first per-tile levels, per level and bin (levels
     /// from `drop_moves.len()` on have none; see [`DropMoves`]): a request
     /// between two bins moves the points beside each code it drops as the
-    /// builder moved them, dropping the bin's codes from the top.
+    /// builder moved them, dropping the bin's codes from the top. Where a
+    /// level has fills too (level 6), a move takes precedence over a fill.
     pub drop_moves: Vec<Vec<DropMoves>>,
 }
 
@@ -146,21 +147,30 @@ pub struct SphereLut {
 #[derive(Clone, Debug, Default)]
 pub struct Offsets {
     decoded: OnceLock<Vec<[i8; 2]>>,
-    /// The zstd frame of the raw pairs, until decoded.
-    frame: Option<Arc<[u8]>>,
+    /// The zstd frames of the raw pairs, until decoded (none once they
+    /// are): the table's own last, and where it is stored as differences
+    /// from the bin below, those of the bins below it first.
+    frames: Vec<Arc<[u8]>>,
     /// How the frame's rows are ordered, if not as in memory.
     order: Option<RowOrder>,
 }
 
 impl Offsets {
-    /// A table still in its zstd frame, its rows in `order`, decoded when
-    /// first read.
-    fn packed(frame: &[u8], order: Option<RowOrder>) -> Self {
+    /// A table still in its zstd frames, its rows in `order`, decoded
+    /// when first read: `frames` are the lowest bin's pairs, then each
+    /// bin's differences from the one below up to this one (see
+    /// [`SphereLut::to_bytes`]).
+    fn packed(frames: Vec<Arc<[u8]>>, order: Option<RowOrder>) -> Self {
         Offsets {
             decoded: OnceLock::new(),
-            frame: Some(frame.into()),
+            frames,
             order,
         }
+    }
+
+    /// Whether the table is still in its frames.
+    fn is_packed(&self) -> bool {
+        !self.frames.is_empty()
     }
 
     /// The offsets, decoded on first use.
@@ -173,21 +183,48 @@ impl Offsets {
         })
     }
 
-    /// The frame's pairs, in memory's row order.
+    /// The frames' pairs, in memory's row order.
     fn decode(&self) -> Result<Vec<[i8; 2]>, Error> {
-        let pairs = decode_pairs(self.frame.as_deref().unwrap_or_default())?;
+        // a default table is empty
+        let Some((first, differences)) = self.frames.split_first() else {
+            return Ok(Vec::new());
+        };
+        let mut pairs = decode_pairs(first)?;
+        for frame in differences {
+            let difference = decode_pairs(frame)?;
+            if difference.len() != pairs.len() {
+                return Err(Error::Table(
+                    "sphere table: an offset table's differences have another size than its bin below".into(),
+                ));
+            }
+            // wrapping, as written: every stored value is an `i8`
+            for (pair, d) in pairs.iter_mut().zip(difference) {
+                *pair = [0, 1].map(|c| pair[c].wrapping_add(d[c]));
+            }
+        }
         Ok(match self.order {
             Some(order) => order.to_memory(pairs),
             None => pairs,
         })
     }
 
-    /// The table's zstd frame, its rows in `order`.
-    fn compress(&self, order: Option<RowOrder>) -> Vec<u8> {
-        let pairs = match order {
+    /// The table's pairs in the file's row `order`.
+    fn to_file(&self, order: Option<RowOrder>) -> Vec<[i8; 2]> {
+        match order {
             Some(order) => order.to_file(self.get().clone()),
             None => self.get().clone(),
-        };
+        }
+    }
+
+    /// The table's zstd frame, its rows in `order`, as differences from
+    /// `below` (a table of the same size) if given.
+    fn compress(&self, order: Option<RowOrder>, below: Option<&Offsets>) -> Vec<u8> {
+        let mut pairs = self.to_file(order);
+        if let Some(below) = below {
+            for (pair, b) in pairs.iter_mut().zip(below.to_file(order)) {
+                *pair = [0, 1].map(|c| pair[c].wrapping_sub(b[c]));
+            }
+        }
         let raw: Vec<u8> = pairs.iter().flatten().map(|&v| v as u8).collect();
         zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL)
             .expect("compressing in memory cannot fail")
@@ -239,8 +276,8 @@ impl RowOrder {
 }
 
 /// One level's offsets in one importance bin, with what a request between
-/// two bins reads in their place beside the codes it drops (the drop
-/// moves, or on the levels without them the sibling fills), as
+/// two bins reads in their place beside the codes it drops (a drop move,
+/// else a sibling fill), as
 /// [`SphereLut::request_offsets`] resolves them once for a request.
 pub(crate) struct LevelOffsets<'a> {
     lut: &'a SphereLut,
@@ -248,7 +285,7 @@ pub(crate) struct LevelOffsets<'a> {
     table: &'a [[i8; 2]],
     /// The level's drop moves in the bin, the first key the request
     /// drops, and whether a ring's faces share the level's rows.
-    moves: Option<(&'a DropMoves, u16, bool)>,
+    moves: Option<(&'a DropMoves, u32, bool)>,
     /// The level's sibling fills, and the request's counts.
     fills: Option<(&'a [[i8; 2]], FillCounts)>,
 }
@@ -272,15 +309,18 @@ impl LevelOffsets<'_> {
         shares_a_hole: impl FnOnce(u64) -> bool,
     ) -> [f64; 2] {
         let row = self.lut.row(self.level, index);
-        let moved = match (self.moves, &self.fills) {
-            (Some((moves, dropped_from, ring)), _) => {
+        // a move where the request drops a code beside the point, else
+        // (level 6 has both) its sibling fill
+        let moved = (self.moves)
+            .and_then(|(moves, dropped_from, ring)| {
                 moves.offset(row, dropped_from, ring.then_some((code & 3) as u8))
-            }
-            (None, Some((fills, counts))) => (counts.pair(code, shares_a_hole))
-                // tree indices: the parent's is the tile's over 4
-                .map(|pair| fills[self.lut.row(self.level - 1, index / 4) * FILL_PAIRS + pair]),
-            (None, None) => None,
-        };
+            })
+            .or_else(|| {
+                let (fills, counts) = self.fills.as_ref()?;
+                (counts.pair(code, shares_a_hole))
+                    // tree indices: the parent's is the tile's over 4
+                    .map(|pair| fills[self.lut.row(self.level - 1, index / 4) * FILL_PAIRS + pair])
+            });
         dequantise(moved.unwrap_or(self.table[row]))
     }
 }
@@ -303,7 +343,7 @@ impl From<Vec<[i8; 2]>> for Offsets {
     fn from(offsets: Vec<[i8; 2]>) -> Self {
         Offsets {
             decoded: OnceLock::from(offsets),
-            frame: None,
+            frames: Vec::new(),
             order: None,
         }
     }
@@ -319,7 +359,7 @@ impl std::ops::Deref for Offsets {
 impl std::ops::DerefMut for Offsets {
     fn deref_mut(&mut self) -> &mut Vec<[i8; 2]> {
         self.get();
-        self.frame = None; // stale once changed
+        self.frames.clear(); // stale once changed
         self.decoded.get_mut().expect("decoded just above")
     }
 }
@@ -453,7 +493,7 @@ impl SphereLut {
         let mut lut = Self::read(bytes)?;
         // decoded and checked in full: a file from outside
         for table in lut.tables.iter_mut().flatten().chain(&mut lut.fills) {
-            if table.frame.is_some() {
+            if table.is_packed() {
                 *table = Offsets::from(table.decode()?);
             }
         }
@@ -480,13 +520,19 @@ impl SphereLut {
         }
         let mut lut: SphereLut = postcard::from_bytes(&header)
             .map_err(|e| Error::Table(format!("sphere table does not decode: {e}")))?;
-        let orders = lut.row_orders();
+        let (orders, chained) = (lut.row_orders(), lut.chained());
         let tables = lut.tables.iter_mut().flatten().chain(&mut lut.fills);
-        for (table, order) in tables.zip(orders) {
+        // the frames a table stored as differences decodes from
+        let mut chain: Vec<Arc<[u8]>> = Vec::new();
+        for ((table, order), chained) in tables.zip(orders).zip(chained) {
             let frame = frames.next().ok_or_else(|| {
                 Error::Table("sphere table does not decompress: it ends before its offsets".into())
             })?;
-            *table = Offsets::packed(frame, order);
+            if !chained {
+                chain.clear();
+            }
+            chain.push(frame.into());
+            *table = Offsets::packed(chain.clone(), order);
         }
         for moves in lut.drop_moves.iter_mut().flatten() {
             let frame = frames.next().ok_or_else(|| {
@@ -497,6 +543,21 @@ impl SphereLut {
             *moves = DropMoves::packed(frame);
         }
         Ok(lut)
+    }
+
+    /// Whether each offset table, in the file's order (see
+    /// [`SphereLut::row_orders`]), is stored as its differences from the
+    /// one before it: a bin of a tree-indexed level but the last, from
+    /// the bin below. Neighbouring bins' offsets are close (coupled, see
+    /// [`crate::optimize::sphere::BinCoupling`]), and this took levels
+    /// 0-5 85 kB smaller; level 6's, uncoupled, grew. A request's first
+    /// read of a bin decodes the bins below it too.
+    fn chained(&self) -> Vec<bool> {
+        let tables = self.tables.iter().enumerate().flat_map(|(level, bins)| {
+            let chained = level + 1 < self.exact_levels as usize;
+            (0..bins.len()).map(move |bin| chained && bin > 0)
+        });
+        tables.chain(self.fills.iter().map(|_| false)).collect()
     }
 
     /// The file's row order of each offset table, in the file's order
@@ -544,9 +605,11 @@ impl SphereLut {
         let raw = postcard::to_allocvec(&header).expect("serialising to memory cannot fail");
         let mut bytes = zstd::bulk::compress(&raw, SPHERE_LUT_ZSTD_LEVEL)
             .expect("compressing in memory cannot fail");
-        let tables = self.tables.iter().flatten().chain(&self.fills);
-        for (table, order) in tables.zip(self.row_orders()) {
-            bytes.extend(table.compress(order));
+        let tables: Vec<&Offsets> = self.tables.iter().flatten().chain(&self.fills).collect();
+        let files = self.row_orders().into_iter().zip(self.chained());
+        for (at, (order, chained)) in files.enumerate() {
+            let below = chained.then(|| tables[at - 1]);
+            bytes.extend(tables[at].compress(order, below));
         }
         for moves in self.drop_moves.iter().flatten() {
             bytes.extend(moves.compress());
@@ -594,20 +657,18 @@ impl SphereLut {
             .drop_moves
             .get(level as usize)
             .and_then(|bins| bins.get(bin));
-        match moves.filter(|_| bin > 0) {
-            Some(moves) => {
-                // whole numbers below 2^53 at the per-tile levels
-                let accepted = accepted_count(fraction, capacity) as u64;
-                let lower = self.bin_codes(bin - 1, capacity);
-                let dropped_from = accepted.saturating_sub(lower).min(u64::from(u16::MAX));
-                let ring = level >= u32::from(self.ring_from);
-                offsets.moves = Some((moves, dropped_from as u16, ring));
-            }
-            None => {
-                let counts = self.fill_counts(level, fraction, capacity, bin);
-                offsets.fills = counts.map(|counts| (&self.fills[level as usize][..], counts));
-            }
+        if let Some(moves) = moves.filter(|_| bin > 0) {
+            // whole numbers below 2^53 at the per-tile levels
+            let accepted = accepted_count(fraction, capacity) as u64;
+            let lower = self.bin_codes(bin - 1, capacity);
+            let ring = level >= u32::from(self.ring_from);
+            // ring keys count whole orbits from the lower count's
+            let base = if ring { lower & !3 } else { lower };
+            let dropped_from = accepted.saturating_sub(base).min(u64::from(u32::MAX));
+            offsets.moves = Some((moves, dropped_from as u32, ring));
         }
+        let counts = self.fill_counts(level, fraction, capacity, bin);
+        offsets.fills = counts.map(|counts| (&self.fills[level as usize][..], counts));
         offsets
     }
 
@@ -873,8 +934,13 @@ impl SphereLut {
             let capacity = (ROOT_COUNT << (2 * level)) as f64;
             for (bin, moves) in bins.iter().enumerate() {
                 // keys are codes less the lower bin's count, below this bin's
+                let ring = level >= self.ring_from as usize;
                 let width = match bin {
                     0 => 0,
+                    // ring keys are whole orbits from the lower count's
+                    _ if ring => (self.bin_codes(bin, capacity)
+                        - (self.bin_codes(bin - 1, capacity) & !3))
+                        .div_ceil(4),
                     _ => self.bin_codes(bin, capacity) - self.bin_codes(bin - 1, capacity),
                 };
                 let wrong = moves.rows() != self.rows(level) && !(bin == 0 && moves.is_empty());

@@ -27,11 +27,11 @@ pub const MOST_MOVES_A_ROW: usize = u8::MAX as usize;
 /// dropped code lies on; keys increase along a row. Kept in its zstd frame
 /// until first read, as [`super::Offsets`] are.
 ///
-/// At the ring-shared levels a move is keyed by the highest code of the
-/// dropped ring orbit (codes equal but for the last two bits, one on each
-/// face): a request that splits the orbit drops its twin on some faces
-/// only, and [`DropMoves::offset`] reads the move where the twin beside
-/// the point is dropped.
+/// At the ring-shared levels a move is keyed by the dropped ring orbit
+/// (codes equal but for the last two bits, one on each face), counted
+/// from the orbit of the lower bin's count: a request that splits the
+/// orbit drops its twin on some faces only, and [`DropMoves::offset`]
+/// reads the move where the twin beside the point is dropped.
 ///
 /// # Example
 /// ```
@@ -42,11 +42,11 @@ pub const MOST_MOVES_A_ROW: usize = u8::MAX as usize;
 /// assert_eq!(moves.offset(0, 4, None), Some([4, 5]));
 /// assert_eq!(moves.offset(0, 10, None), None);
 /// assert_eq!(moves.offset(1, 0, None), None);
-/// // shared by a ring: key 9 is an orbit's highest code, 6..=9; a request
-/// // keeping the keys below 8 drops the twins that are members 2 and 3
+/// // shared by a ring: key 9 is the orbit of codes 36..40; a request
+/// // keeping the codes below 38 drops the twins that are members 2 and 3
 /// // (faces 1 and 3 of the ring, the point's own face here)
-/// assert_eq!(moves.offset(0, 8, Some(2)), Some([4, 5]));
-/// assert_eq!(moves.offset(0, 8, Some(1)), None);
+/// assert_eq!(moves.offset(0, 38, Some(2)), Some([4, 5]));
+/// assert_eq!(moves.offset(0, 38, Some(1)), None);
 /// ```
 pub struct DropMoves {
     decoded: OnceLock<MoveRows>,
@@ -111,21 +111,24 @@ impl DropMoves {
     /// The offset of row `row` for a request that drops the keys from
     /// `dropped_from` up: the move of its lowest such key, `None` if the
     /// request drops none of the row's. Where rows are shared by a ring,
-    /// `member` is the point's code's last two bits, and a move counts
-    /// where the request drops the orbit's twin beside the point.
+    /// `member` is the point's code's last two bits, a key is a ring orbit
+    /// (its codes `4 * key .. 4 * key + 4`, counted from the lower bin's
+    /// count rounded down to a whole orbit, which keeps level 6's bins
+    /// within 16 bits), `dropped_from` counts codes from there, and a move
+    /// counts where the request drops the orbit's twin beside the point.
     #[inline]
-    pub fn offset(&self, row: usize, dropped_from: u16, member: Option<u8>) -> Option<[i8; 2]> {
+    pub fn offset(&self, row: usize, dropped_from: u32, member: Option<u8>) -> Option<[i8; 2]> {
         let moves = self.get();
         let (start, end) = (moves.starts[row] as usize, moves.starts[row + 1] as usize);
         // a few moves a row: a scan beats a binary search
         let found = match member {
-            None => (start..end).find(|&k| moves.keys[k] >= dropped_from),
+            None => (start..end).find(|&k| u32::from(moves.keys[k]) >= dropped_from),
             Some(member) => {
-                // the twin's code is the key's less 3 plus its member
+                // the twin's code is the orbit's first plus its member
                 let face = MEMBER_OF_FACE[(member & 3) as usize];
                 let twin = |k: usize| MEMBER_OF_FACE[((face + moves.turns[k]) & 3) as usize];
-                let from = u32::from(dropped_from) + 3;
-                (start..end).find(|&k| u32::from(moves.keys[k]) + u32::from(twin(k)) >= from)
+                (start..end)
+                    .find(|&k| 4 * u32::from(moves.keys[k]) + u32::from(twin(k)) >= dropped_from)
             }
         };
         found.map(|k| moves.offsets[k])
@@ -290,7 +293,7 @@ mod tests {
         #[test]
         fn moves_round_trip_and_read_the_lowest_dropped_key(
             rows in prop::collection::vec(prop::collection::btree_map(0u16..500, (any::<i8>(), any::<i8>(), 0u8..4), 0..6), 1..20),
-            from in 0u16..520,
+            from in 0u32..2100,
             member in 0u8..4,
         ) {
             let lists: Vec<Vec<(u16, [i8; 2], u8)>> = (rows.iter())
@@ -301,17 +304,15 @@ mod tests {
             packed.unpack().unwrap();
             prop_assert_eq!(&packed, &moves);
             for (row, list) in lists.iter().enumerate() {
-                let expected = list.iter().find(|m| m.0 >= from).map(|m| m.1);
+                let expected = list.iter().find(|m| u32::from(m.0) >= from).map(|m| m.1);
                 prop_assert_eq!(packed.offset(row, from, None), expected);
                 // on a ring: the twin on the face `turn` quarter turns on
                 let face = |m: u8| [0u8, 2, 1, 3][m as usize];
                 let dropped = |m: &(u16, [i8; 2], u8)| {
-                    u32::from(m.0) - 3 + u32::from(face((face(member) + m.2) % 4)) >= u32::from(from)
+                    4 * u32::from(m.0) + u32::from(face((face(member) + m.2) % 4)) >= from
                 };
-                let on_ring = list.iter().filter(|m| m.0 >= 3).find(|m| dropped(m)).map(|m| m.1);
-                if list.iter().all(|m| m.0 >= 3) {
-                    prop_assert_eq!(packed.offset(row, from, Some(member)), on_ring);
-                }
+                let on_ring = list.iter().find(|m| dropped(m)).map(|m| m.1);
+                prop_assert_eq!(packed.offset(row, from, Some(member)), on_ring);
             }
         }
     }

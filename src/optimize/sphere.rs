@@ -66,10 +66,14 @@ pub struct BuildOptions {
     /// those with drop moves (their tables stay empty).
     pub fill_levels: u8,
     /// Levels `0..drop_move_levels` get drop moves (see
-    /// [`crate::lut::DropMoves`]) in place of sibling fills. Their keys
-    /// are 16 bits wide, which holds the bins of levels 0-5; level 6's
-    /// moves, four times level 5's 640 kB, would not fit the 4 MB budget.
+    /// [`crate::lut::DropMoves`]), in place of sibling fills up to
+    /// `selective_moves_from`. Their keys are 16 bits wide (ring orbits on
+    /// the ring-shared levels), which holds the bins of levels 0-6.
     pub drop_move_levels: u8,
+    /// Levels from this one keep their sibling fills, and their drops
+    /// move points only where the fills leave a hole: level 6's moves for
+    /// every drop took 2.15 MB, past the 4 MB budget.
+    pub selective_moves_from: u8,
     /// First level whose neighbourhood classes are enumerated and relaxed,
     /// below `exact_levels`: each class level relaxes from the one above,
     /// so the class table starts warm (started cold, its classes crowded
@@ -172,7 +176,8 @@ impl Default for BuildOptions {
             exact_levels: 7,
             ring_from: 4,
             fill_levels: 7,
-            drop_move_levels: 6,
+            drop_move_levels: 7,
+            selective_moves_from: 6,
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
@@ -281,14 +286,15 @@ pub fn build(
         || options.deep_tile_step == 0
         || options.class_depth > 10
         || options.class_separation_depth > 2
-        || options.drop_move_levels > options.exact_levels.min(6)
+        || options.drop_move_levels > options.exact_levels
+        || !drop_move_keys_fit(options)
         || !(options.bin_coupling.strength >= 0.0 && options.bin_coupling.strength.is_finite())
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
              0 < fill_levels <= exact_levels, bins >= 6, deep_tile_step > 0, 0 < class_separation_depth <= 2, \
-             drop_move_levels <= min(exact_levels, 6), a finite bin coupling >= 0)"
+             drop_move_levels <= exact_levels with 16-bit keys, a finite bin coupling >= 0)"
         )));
     }
     let mut report = BuildReport::default();
@@ -375,9 +381,30 @@ pub fn build(
     lut.fills = fills.into_iter().map(Offsets::from).collect();
     lap(&mut report, "sibling fills");
 
-    lut.drop_moves = drop_moves::drop_moves(&enumerator, &lut, options, progress);
+    // the selective levels' drops start from the fills' places
+    let with_fills = SphereTiling::new(Arc::new(lut.clone()));
+    lut.drop_moves = drop_moves::drop_moves(&with_fills, &lut, options, progress);
     lap(&mut report, "drop moves");
     Ok((lut, report))
+}
+
+/// Whether every bin of every level with drop moves keys its moves in 16
+/// bits: its codes above the lower bin's count, whole ring orbits on the
+/// ring-shared levels (see [`crate::lut::DropMoves`]).
+fn drop_move_keys_fit(options: &BuildOptions) -> bool {
+    let fractions = crate::lut::bin_fractions(options.bins as usize);
+    (0..options.drop_move_levels).all(|level| {
+        let capacity = (crate::lut::ROOT_COUNT << (2 * u32::from(level))) as f64;
+        let codes = |fraction: f64| (fraction * capacity).ceil() as u64;
+        (fractions.windows(2)).all(|pair| {
+            let (lower, upper) = (codes(pair[0]), codes(pair[1]));
+            let keys = match level >= options.ring_from {
+                true => (upper - (lower & !3)).div_ceil(4),
+                false => upper - lower,
+            };
+            keys <= 1 << 16
+        })
+    })
 }
 
 /// A level's offsets, relaxed as `row * bins + bin`, split into the table
@@ -1824,7 +1851,8 @@ fn sibling_fills(
     progress: Progress,
 ) -> Vec<Vec<[i8; 2]>> {
     let fill_levels = u32::from(options.fill_levels);
-    let moved = u32::from(options.drop_move_levels);
+    // levels that drop moves replace have empty tables
+    let moved = u32::from(options.drop_move_levels.min(options.selective_moves_from));
     let mut fills = vec![Vec::new(); moved.clamp(1, fill_levels) as usize];
     for level in moved.max(1)..fill_levels {
         let step = options.grid_step(level);

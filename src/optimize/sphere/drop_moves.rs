@@ -9,6 +9,11 @@
 //! sqrt(N) a level, because a dropped point's siblings alone cannot
 //! close its hole; moving every kept point within 1.5 spacings of it
 //! reads 2.9-3.2 on levels 0-5, separation staying at 2.55 or more.
+//!
+//! Level 6's moves for every drop took 2.15 MB (1.30 MB storing none
+//! shorter than 0.2 spacings, covering then 3.38-3.75), past the 4 MB
+//! budget. It keeps its sibling fills, and a drop moves points only where
+//! it leaves a hole the fills do not close (see [`HOLE_WIDER`]).
 
 use super::{skew, to_local, within_room, BinSet, BuildOptions, Progress};
 use crate::lut::{dequantise, DropMoves, SphereLut};
@@ -37,11 +42,19 @@ const STOPPED: f64 = 0.1;
 /// Rounds of pinning a drop, at most.
 const PIN_ROUNDS: usize = 2;
 /// A move shorter than this many spacings is neither made nor stored,
-/// per level, which keeps the table small: level 5's moves took 811 kB
-/// at 0.05 and 640 kB at 0.10, and over 20 counts between its bins the
-/// covering radius moved from 3.09 to 3.11 / sqrt(N) on average (worst
-/// 3.32 and 3.27).
-const SHORTEST: [f64; 6] = [0.05, 0.05, 0.05, 0.05, 0.05, 0.10];
+/// which keeps the table small: level 5's moves took 811 kB at 0.05 and
+/// 640 kB at 0.10, and over 20 counts between its bins the covering
+/// radius moved from 3.09 to 3.11 / sqrt(N) on average (worst 3.32 and
+/// 3.27). Levels 0-4's took 120 kB less at 0.10 than at 0.05, their
+/// sweep counts keeping separation >= 2.52 and covering <= 3.08.
+const SHORTEST: f64 = 0.10;
+/// On the levels that keep their sibling fills, a drop moves points only
+/// where, the fills in place, it leaves a hole wider than this over
+/// sqrt(N) (the widest Voronoi cell radius of the kept points about it).
+/// Over 30 log-spaced counts on level 6: 3.25 stored 350 kB of moves and
+/// kept covering within 3.383 at all 30; 3.35, 219 kB and 29 of 30
+/// within 3.4 (3.408); the fills alone, 1 of 30 (worst 4.39).
+const HOLE_WIDER: f64 = 3.35;
 
 /// Shares of the way to their relaxed places the moves of one drop go,
 /// the first that keeps the points [`GUARD`] apart winning.
@@ -64,6 +77,8 @@ fn nearest(points: &[DVec3], k: usize) -> f64 {
 
 /// The drop moves of levels `0..options.drop_move_levels`, per level and
 /// bin (bin 0, whose requests come from the level above, has none).
+/// `tiling` reads `lut`'s sibling fills, which the levels from
+/// `options.selective_moves_from` on keep.
 pub(super) fn drop_moves(
     tiling: &SphereTiling,
     lut: &SphereLut,
@@ -76,9 +91,11 @@ pub(super) fn drop_moves(
             let mut by_code = tiling.tiles(level);
             by_code.sort_unstable_by_key(|t| t.code);
             let mut bins = vec![DropMoves::default()];
+            let fills = level >= u32::from(options.selective_moves_from);
             bins.par_extend((1..lut.bins()).into_par_iter().map(|bin| {
                 let step = options.grid_step(level);
-                BinDrops::new(BinSet::new(tiling, lut, &by_code, bin), step).solve()
+                let set = BinSet::new(tiling, lut, &by_code, bin);
+                BinDrops::new(set, step, fills).solve()
             }));
             progress("drop moves", u64::from(level) + 1, u64::from(levels));
             bins
@@ -114,10 +131,17 @@ struct BinDrops<'a> {
     /// Each point's offset and place after the drops so far.
     stored: Vec<[i8; 2]>,
     current: Vec<DVec3>,
+    /// On a level that keeps its sibling fills, the [`HOLE_WIDER`] a drop
+    /// moves points past, and whether each point has moved (the others
+    /// follow their fills).
+    hole_wider: Option<f64>,
+    moved: Vec<bool>,
 }
 
 impl<'a> BinDrops<'a> {
-    fn new(set: BinSet<'a>, step: u8) -> Self {
+    /// The drops of `set`'s bin, its moves on a grid of `step`; with
+    /// `fills`, on top of the level's sibling fills.
+    fn new(set: BinSet<'a>, step: u8, fills: bool) -> Self {
         let lower = set.below();
         let BinSet {
             tiling,
@@ -145,14 +169,16 @@ impl<'a> BinDrops<'a> {
             room: tiling.shape().dilated().dilated().dilated(),
             tree,
             current: sites.clone(),
+            hole_wider: fills.then_some(HOLE_WIDER),
+            moved: vec![false; sites.len()],
             sites,
             stored,
         }
     }
 
     /// Drops the codes from the top, a ring orbit at a time where rows
-    /// are shared (keyed by its highest code), and returns the moves row
-    /// by row.
+    /// are shared (keyed by its place among the orbits from the lower
+    /// count's), and returns the moves row by row.
     fn solve(mut self) -> DropMoves {
         let mut rows = vec![Vec::new(); self.lut.rows(self.level)];
         let mut top = self.sites.len();
@@ -168,7 +194,12 @@ impl<'a> BinDrops<'a> {
             // even there: its holes stay open, or the bin's own set moved
             let split = self.ring && first + 3 >= self.sites.len();
             if !split {
-                let key = (first + 3 * usize::from(self.ring) - self.lower) as u16;
+                let key = match self.ring {
+                    true => (first - (self.lower & !3)) / 4,
+                    false => first - self.lower,
+                };
+                // `build` checks that every bin's keys fit
+                let key = u16::try_from(key).expect("a bin's keys fit 16 bits");
                 for (row, offset, turn) in self.drop(first..top) {
                     rows[row].push((key, offset, turn));
                 }
@@ -184,48 +215,166 @@ impl<'a> BinDrops<'a> {
     /// Drops `codes` and relaxes the kept points beside the hole; stores
     /// the moves (the state follows them) and returns them by row, each
     /// with the turn from its point's face to its nearest dropped code's.
+    /// On a level that keeps its fills, the points about the hole first
+    /// take the fills a request keeping the codes below `codes` reads, and
+    /// the drop moves points only if the hole stays wider than
+    /// [`HOLE_WIDER`].
     fn drop(&mut self, codes: std::ops::Range<usize>) -> Vec<(usize, [i8; 2], u8)> {
         let kept = codes.start;
         let spacing = (4.0 * PI / kept as f64).sqrt();
-        let within = |code: usize, radius: f64| {
-            let at = (skew() * self.sites[code]).to_array();
-            (self
-                .tree
-                .within_unsorted::<SquaredEuclidean>(&at, radius * radius)
-                .into_iter())
-            .map(|near| near.item as usize)
-        };
         // the hole: these codes and those dropped before them nearby
-        let hole: Vec<DVec3> = (codes.clone().flat_map(|c| within(c, HOLE * spacing)))
+        let mut hole: Vec<DVec3> = (codes.clone().flat_map(|c| self.within(c, HOLE * spacing)))
             .filter(|&c| c >= kept)
             .map(|c| self.current[c])
             .collect();
-        let mut around: Vec<usize> = (codes.clone().flat_map(|c| within(c, AROUND * spacing)))
+        let mut around: Vec<usize> = (codes.clone())
+            .flat_map(|c| self.within(c, AROUND * spacing))
             .filter(|&c| c < kept)
             .collect();
         around.sort_unstable();
         around.dedup();
+        let (mut moves, mut filled) = (Vec::new(), Vec::new());
+        if let Some(wider) = self.hole_wider {
+            let vacated;
+            (moves, vacated) = self.follow_fills(&around, kept);
+            // the places the fills vacate open the hole too, and the guard
+            // must see the points about them: without, points the drop
+            // moved crowded others beyond `around` (0.71 / sqrt(N))
+            for &(code, place) in &vacated {
+                hole.push(place);
+                around.extend((self.within(code, AROUND * spacing)).filter(|&c| c < kept));
+                filled.push(code);
+            }
+            around.sort_unstable();
+            around.dedup();
+            if self.widest_hole(&around, &hole, spacing) * (kept as f64).sqrt() <= wider {
+                return self.by_row(moves, codes);
+            }
+        }
         let start: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let movable: Vec<usize> = (0..around.len())
+            .filter(|&k| !filled.contains(&around[k]))
             .filter(|&k| hole.iter().any(|h| start[k].distance(*h) < REACH * spacing))
             .collect();
         if movable.is_empty() {
-            return Vec::new();
+            return self.by_row(moves, codes);
         }
         let (movable, targets) = self.relax_within_room(&around, &start, movable, spacing);
-        let shortest = SHORTEST[self.level] * spacing;
+        let shortest = SHORTEST * spacing;
         // the moves all the way, or a share of the way where a point the
         // room stopped short left another too close to it
-        let Some(moves) = (SHARES.iter())
+        let relaxed = (SHARES.iter())
             .map(|&share| self.share_moves(&around, &movable, &targets, share, shortest))
-            .find(|moves| self.clear(&around, &start, moves, kept))
-        else {
-            return Vec::new();
-        };
+            .find(|moves| self.clear(&around, &start, moves, kept));
+        // they take the rows of the fills' reverts (see `follow_fills`)
+        moves = relaxed
+            .unwrap_or_default()
+            .into_iter()
+            .chain(moves)
+            .collect();
+        self.by_row(moves, codes)
+    }
+
+    /// Kept codes within `radius` of `code`'s bin place.
+    fn within(&self, code: usize, radius: f64) -> impl Iterator<Item = usize> {
+        let at = (skew() * self.sites[code]).to_array();
+        (self
+            .tree
+            .within_unsorted::<SquaredEuclidean>(&at, radius * radius))
+        .into_iter()
+        .map(|near| near.item as usize)
+    }
+
+    /// Moves the points of `around` that have not moved to the fills a
+    /// request keeping `kept` codes reads. Where that crowds a point, its
+    /// family (siblings: codes equal modulo the parents' count) keeps its
+    /// previous offsets, as moves: reverting the one sibling alone left a
+    /// pair 1.93 / sqrt(N) apart. Returns those moves `(row, code,
+    /// offset)`, and each code that took a fill with the place it left.
+    fn follow_fills(
+        &mut self,
+        around: &[usize],
+        kept: usize,
+    ) -> (Vec<(usize, usize, [i8; 2])>, Vec<(usize, DVec3)>) {
+        let before: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
+        // (index into `around`, offset before)
+        let mut changed: Vec<(usize, [i8; 2])> = Vec::new();
+        for (k, &code) in around.iter().enumerate() {
+            if self.moved[code] {
+                continue;
+            }
+            let fill = self.fill_offset(code, kept);
+            if fill != self.stored[code] {
+                changed.push((k, self.stored[code]));
+                self.stored[code] = fill;
+                self.current[code] = self.place(code, fill);
+            }
+        }
+        let family = |code: usize| code % (self.by_code.len() / 4);
+        let mut reverted = vec![false; changed.len()];
+        let mut moves = Vec::new();
+        loop {
+            let now: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
+            let crowded: Vec<usize> = (changed.iter().zip(&reverted))
+                .filter(|&(&(k, _), &reverted)| {
+                    !reverted && nearest(&now, k) < self.guard.min(nearest(&before, k))
+                })
+                .map(|(&(k, _), _)| family(around[k]))
+                .collect();
+            if crowded.is_empty() {
+                break;
+            }
+            for (&(k, previous), reverted) in changed.iter().zip(&mut reverted) {
+                let code = around[k];
+                if *reverted || !crowded.contains(&family(code)) {
+                    continue;
+                }
+                *reverted = true;
+                for twin in self.twins(code, kept) {
+                    self.stored[twin] = previous;
+                    self.current[twin] = self.place(twin, previous);
+                    self.moved[twin] = true;
+                }
+                moves.push((self.row_of(code), code, previous));
+            }
+        }
+        let vacated = (changed.iter().zip(&reverted))
+            .filter(|(_, &reverted)| !reverted)
+            .map(|(&(k, _), _)| (around[k], before[k]))
+            .collect();
+        (moves, vacated)
+    }
+
+    /// The widest Voronoi cell radius of the points of `around` within
+    /// [`REACH`] spacings of `hole`, among the points of `around`.
+    fn widest_hole(&self, around: &[usize], hole: &[DVec3], spacing: f64) -> f64 {
+        let points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
+        let mut normals = Vec::new();
+        (0..points.len())
+            .filter(|&k| {
+                hole.iter()
+                    .any(|h| points[k].distance(*h) < REACH * spacing)
+            })
+            .map(|k| crate::voronoi::cell_of(&points, None, k, &mut normals, f64::INFINITY).radius)
+            .fold(0.0, f64::max)
+    }
+
+    /// Stores `moves` `(row, code, offset)` of the drop of `codes` (the
+    /// state follows them) and returns them one a row, the lowest code's,
+    /// each with the turn from its point's face to its nearest dropped
+    /// code's.
+    fn by_row(
+        &mut self,
+        mut moves: Vec<(usize, usize, [i8; 2])>,
+        codes: std::ops::Range<usize>,
+    ) -> Vec<(usize, [i8; 2], u8)> {
+        moves.sort_by_key(|&(row, code, _)| (row, code));
+        moves.dedup_by_key(|m| m.0);
         for &(_, code, offset) in &moves {
-            for twin in self.twins(code, kept) {
+            for twin in self.twins(code, codes.start) {
                 self.stored[twin] = offset;
                 self.current[twin] = self.place(twin, offset);
+                self.moved[twin] = true;
             }
         }
         let turn = |code: usize| {
@@ -240,6 +389,19 @@ impl<'a> BinDrops<'a> {
         (moves.into_iter())
             .map(|(row, code, offset)| (row, offset, if self.ring { turn(code) } else { 0 }))
             .collect()
+    }
+
+    /// The offset a request keeping `count` codes reads for `code` (this
+    /// bin's, or a sibling fill), as stored.
+    fn fill_offset(&self, code: usize, count: usize) -> [i8; 2] {
+        let fraction = count as f64 / self.by_code.len() as f64;
+        let offset = self.tiling.offset(&self.by_code[code], fraction);
+        SphereLut::quantise_on(offset, 1)
+    }
+
+    /// The row of `code`'s tile.
+    fn row_of(&self, code: usize) -> usize {
+        self.lut.row(self.level, self.by_code[code].index as usize)
     }
 
     /// Relaxes `movable` (indices into `around`, at `start`) among the
@@ -320,8 +482,7 @@ impl<'a> BinDrops<'a> {
                 let to = [0, 1].map(|c| from[c] + share * (target[c] - from[c]));
                 let offset = SphereLut::quantise_on(to, self.step);
                 let moved = self.place(code, offset).distance(self.current[code]);
-                let row = self.lut.row(self.level, self.by_code[code].index as usize);
-                (moved >= shortest).then_some((row, code, offset))
+                (moved >= shortest).then_some((self.row_of(code), code, offset))
             })
             .collect();
         moves.sort_unstable_by_key(|&(row, code, _)| (row, code));
