@@ -67,6 +67,9 @@ const SHARES: [f64; 5] = [1.0, 0.75, 0.5, 0.25, 0.0];
 /// count read 2.39 at N = 120,000.
 const GUARD: f64 = 0.70;
 
+/// A move as a drop makes it: `(row, code, offset)`.
+type Move = (usize, usize, [i8; 2]);
+
 /// The distance from `points[k]` to its nearest other point.
 fn nearest(points: &[DVec3], k: usize) -> f64 {
     (0..points.len())
@@ -291,11 +294,7 @@ impl<'a> BinDrops<'a> {
     /// previous offsets, as moves: reverting the one sibling alone left a
     /// pair 1.93 / sqrt(N) apart. Returns those moves `(row, code,
     /// offset)`, and each code that took a fill with the place it left.
-    fn follow_fills(
-        &mut self,
-        around: &[usize],
-        kept: usize,
-    ) -> (Vec<(usize, usize, [i8; 2])>, Vec<(usize, DVec3)>) {
+    fn follow_fills(&mut self, around: &[usize], kept: usize) -> (Vec<Move>, Vec<(usize, DVec3)>) {
         let before: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         // (index into `around`, offset before)
         let mut changed: Vec<(usize, [i8; 2])> = Vec::new();
@@ -365,7 +364,7 @@ impl<'a> BinDrops<'a> {
     /// code's.
     fn by_row(
         &mut self,
-        mut moves: Vec<(usize, usize, [i8; 2])>,
+        mut moves: Vec<Move>,
         codes: std::ops::Range<usize>,
     ) -> Vec<(usize, [i8; 2], u8)> {
         moves.sort_by_key(|&(row, code, _)| (row, code));
@@ -474,8 +473,8 @@ impl<'a> BinDrops<'a> {
         targets: &[[f64; 2]],
         share: f64,
         shortest: f64,
-    ) -> Vec<(usize, usize, [i8; 2])> {
-        let mut moves: Vec<(usize, usize, [i8; 2])> = (movable.iter().zip(targets))
+    ) -> Vec<Move> {
+        let mut moves: Vec<Move> = (movable.iter().zip(targets))
             .filter_map(|(&k, target)| {
                 let code = around[k];
                 let from = dequantise(self.stored[code]);
@@ -504,13 +503,7 @@ impl<'a> BinDrops<'a> {
     /// on the points as the table will place them (a point whose move was
     /// too short to store, checked as moved, let a neighbour come within
     /// 2.36 / sqrt(N) of it at N = 120,000).
-    fn clear(
-        &self,
-        around: &[usize],
-        start: &[DVec3],
-        moves: &[(usize, usize, [i8; 2])],
-        kept: usize,
-    ) -> bool {
+    fn clear(&self, around: &[usize], start: &[DVec3], moves: &[Move], kept: usize) -> bool {
         let mut points = start.to_vec();
         let mut moved = Vec::new();
         for &(_, code, offset) in moves {
