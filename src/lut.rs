@@ -742,7 +742,7 @@ impl SphereLut {
     /// ```
     /// let lut = tessera::lut::sphere_lut();
     /// // level 6, the one with sibling fills; 245,760 parents
-    /// assert_eq!(lut.drop_moves.len(), 6);
+    /// assert!(!lut.fills[6].is_empty());
     /// let capacity = 983_040.0;
     /// let fraction = 332_800.0 / capacity;
     /// let bin = lut.bin(fraction, capacity);
@@ -759,7 +759,7 @@ impl SphereLut {
     /// let bin = lut.bin(fraction, capacity);
     /// assert_eq!(lut.fill_pair(100_002, 6, fraction, bin, capacity, apart), Some(0));
     /// assert_eq!(lut.fill_pair(100_002, 6, fraction, bin, capacity, |_| true), None);
-    /// // the levels with drop moves have none
+    /// // the levels whose drop moves replace them have none
     /// assert_eq!(lut.fill_pair(390, 2, 1300.0 / 3840.0, 3, 3840.0, apart), None);
     /// ```
     pub fn fill_pair(
