@@ -488,7 +488,7 @@ impl SphereLut {
     /// assert_eq!(lut.bin_codes(lut.bins() - 1, 960.0), 960);
     /// ```
     pub fn bin_codes(&self, bin: usize, capacity: f64) -> u64 {
-        (self.bin_fractions[bin] * capacity).ceil() as u64
+        codes_below(self.bin_fractions[bin], capacity)
     }
 
     /// Decodes a table, checking its version and internal consistency.
@@ -670,9 +670,8 @@ impl SphereLut {
             let accepted = accepted_count(fraction, capacity) as u64;
             let lower = self.bin_codes(bin - 1, capacity);
             let ring = level >= u32::from(self.ring_from);
-            // ring keys count whole orbits from the lower count's
-            let base = if ring { lower & !3 } else { lower };
-            let dropped_from = accepted.saturating_sub(base).min(u64::from(u32::MAX));
+            let dropped_from =
+                (accepted.saturating_sub(move_key_base(lower, ring))).min(u64::from(u32::MAX));
             offsets.moves = Some((moves, dropped_from as u32, ring));
         }
         let counts = self.fill_counts(level, fraction, capacity, bin);
@@ -941,15 +940,15 @@ impl SphereLut {
             }
             let capacity = (ROOT_COUNT << (2 * level)) as f64;
             for (bin, moves) in bins.iter().enumerate() {
-                // keys are codes less the lower bin's count, below this bin's
+                // keys count from the lower bin's count, below this bin's
                 let ring = level >= self.ring_from as usize;
                 let width = match bin {
                     0 => 0,
-                    // ring keys are whole orbits from the lower count's
-                    _ if ring => (self.bin_codes(bin, capacity)
-                        - (self.bin_codes(bin - 1, capacity) & !3))
-                        .div_ceil(4),
-                    _ => self.bin_codes(bin, capacity) - self.bin_codes(bin - 1, capacity),
+                    _ => move_keys(
+                        self.bin_codes(bin - 1, capacity),
+                        self.bin_codes(bin, capacity),
+                        ring,
+                    ),
                 };
                 let wrong = moves.rows() != self.rows(level) && !(bin == 0 && moves.is_empty());
                 // a move may take a point two cells past its tile, as far as
@@ -962,6 +961,31 @@ impl SphereLut {
             }
         }
         Ok(())
+    }
+}
+
+/// Codes below `fraction * capacity`: the set of a bin of that fraction.
+pub(crate) fn codes_below(fraction: f64, capacity: f64) -> u64 {
+    (fraction * capacity).ceil() as u64
+}
+
+/// The code a bin's drop-move keys count from: the lower bin's count
+/// `lower`, rounded down to a whole orbit where a ring's faces share rows
+/// (see [`DropMoves`]).
+pub(crate) fn move_key_base(lower: u64, ring: bool) -> u64 {
+    match ring {
+        true => lower & !3,
+        false => lower,
+    }
+}
+
+/// How many drop-move keys a bin of `upper` codes above one of `lower`
+/// spans: codes, or on the ring-shared levels whole orbits.
+pub(crate) fn move_keys(lower: u64, upper: u64, ring: bool) -> u64 {
+    let codes = upper - move_key_base(lower, ring);
+    match ring {
+        true => codes.div_ceil(4),
+        false => codes,
     }
 }
 

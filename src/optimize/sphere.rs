@@ -392,17 +392,16 @@ pub fn build(
 /// bits: its codes above the lower bin's count, whole ring orbits on the
 /// ring-shared levels (see [`crate::lut::DropMoves`]).
 fn drop_move_keys_fit(options: &BuildOptions) -> bool {
+    use crate::lut::{codes_below, move_keys};
     let fractions = crate::lut::bin_fractions(options.bins as usize);
     (0..options.drop_move_levels).all(|level| {
         let capacity = (crate::lut::ROOT_COUNT << (2 * u32::from(level))) as f64;
-        let codes = |fraction: f64| (fraction * capacity).ceil() as u64;
         (fractions.windows(2)).all(|pair| {
-            let (lower, upper) = (codes(pair[0]), codes(pair[1]));
-            let keys = match level >= options.ring_from {
-                true => (upper - (lower & !3)).div_ceil(4),
-                false => upper - lower,
-            };
-            keys <= 1 << 16
+            let (lower, upper) = (
+                codes_below(pair[0], capacity),
+                codes_below(pair[1], capacity),
+            );
+            move_keys(lower, upper, level >= options.ring_from) <= 1 << 16
         })
     })
 }

@@ -16,7 +16,7 @@
 //! it leaves a hole the fills do not close (see [`HOLE_WIDER`]).
 
 use super::{skew, to_local, within_room, BinSet, BuildOptions, Progress};
-use crate::lut::{dequantise, DropMoves, SphereLut};
+use crate::lut::{dequantise, move_key_base, DropMoves, SphereLut};
 use crate::polyomino::Shape;
 use crate::relax::relax_among_fixed;
 use crate::tiling::sphere::{SphereTile, SphereTiling};
@@ -197,10 +197,8 @@ impl<'a> BinDrops<'a> {
             // even there: its holes stay open, or the bin's own set moved
             let split = self.ring && first + 3 >= self.sites.len();
             if !split {
-                let key = match self.ring {
-                    true => (first - (self.lower & !3)) / 4,
-                    false => first - self.lower,
-                };
+                let from = move_key_base(self.lower as u64, self.ring) as usize;
+                let key = (first - from) / if self.ring { 4 } else { 1 };
                 // `build` checks that every bin's keys fit
                 let key = u16::try_from(key).expect("a bin's keys fit 16 bits");
                 for (row, offset, turn) in self.drop(first..top) {
