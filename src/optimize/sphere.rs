@@ -2411,6 +2411,37 @@ mod tests {
                 prop_assert!(error <= f64::from(step) / 2.0 + 1e-9, "{:?} -> {:?}", [x, y], back);
             }
         }
+
+        /// A point inside a site's inner disc has that site as its
+        /// nearest, as the k-d tree finds it; a site with a twin has none.
+        #[test]
+        fn a_point_inside_a_sites_inner_disc_is_nearest_to_it(
+            sites in prop::collection::vec((-1.0f64..1.0, 0.0f64..std::f64::consts::TAU), 2..40),
+            queries in prop::collection::vec((-1.0f64..1.0, 0.0f64..std::f64::consts::TAU), 1..200),
+            twin in any::<bool>(),
+        ) {
+            let on_sphere = |&(z, phi): &(f64, f64)| {
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            };
+            let mut sites: Vec<DVec3> = sites.iter().map(on_sphere).collect();
+            if twin {
+                sites.push(sites[0]);
+            }
+            let tree = site_tree(&sites);
+            let owns = inner_radii(&tree, &sites);
+            if twin {
+                prop_assert_eq!(owns[0], 0.0);
+            }
+            for q in queries.iter().map(on_sphere) {
+                let nearest = tree.nearest_one::<SquaredEuclidean>(&(skew() * q).to_array());
+                for (k, &site) in sites.iter().enumerate() {
+                    if q.distance_squared(site) < owns[k] {
+                        prop_assert_eq!(nearest.item as usize, k);
+                    }
+                }
+            }
+        }
     }
 
     /// Level 1 relaxed one bin at a time crowds where two neighbouring
