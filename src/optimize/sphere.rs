@@ -1698,14 +1698,8 @@ fn separate(
                         if !movable[set[k].1] {
                             return (k, f64::INFINITY);
                         }
-                        let found = tree.nearest_n::<SquaredEuclidean>(
-                            &(skew * site).to_array(),
-                            std::num::NonZeroUsize::new(2).expect("2 > 0"),
-                        );
-                        found
-                            .iter()
-                            .find(|n| n.item as usize != k)
-                            .map_or((k, f64::INFINITY), |n| (n.item as usize, n.distance.sqrt()))
+                        nearest_other(&tree, skew, site, k)
+                            .map_or((k, f64::INFINITY), |(j, d2)| (j, d2.sqrt()))
                     })
                     .collect();
                 worst = nearest.iter().fold(worst, |w, &(_, d)| w.min(d * scale));
@@ -1848,17 +1842,30 @@ fn site_tree(sites: &[DVec3]) -> ImmutableKdTree<f64, u32, 3, 32> {
 /// and levels 0-3 now relax in half the time, to the same offsets.
 fn inner_radii(tree: &ImmutableKdTree<f64, u32, 3, 32>, sites: &[DVec3]) -> Vec<f64> {
     let skew = skew();
-    let two = std::num::NonZeroUsize::new(2).expect("2 > 0");
     sites
         .par_iter()
-        .map(|&site| {
-            let found = tree.nearest_n::<SquaredEuclidean>(&(skew * site).to_array(), two);
-            // the site itself comes first; a twin at distance 0 gives 0
-            found
-                .get(1)
-                .map_or(f64::INFINITY, |other| other.distance / 4.0 * (1.0 - 1e-9))
+        .enumerate()
+        .map(|(k, &site)| {
+            // a twin at distance 0 gives 0
+            nearest_other(tree, skew, site, k)
+                .map_or(f64::INFINITY, |(_, d2)| d2 / 4.0 * (1.0 - 1e-9))
         })
         .collect()
+}
+
+/// The nearest of the sites in `tree` (see [`site_tree`], rotated by
+/// `skew`) to site `k`, at `site`, other than itself, and its squared distance; `None` if `k`
+/// is alone.
+fn nearest_other(
+    tree: &ImmutableKdTree<f64, u32, 3, 32>,
+    skew: glam::DQuat,
+    site: DVec3,
+    k: usize,
+) -> Option<(usize, f64)> {
+    let two = std::num::NonZeroUsize::new(2).expect("2 > 0");
+    let found = tree.nearest_n::<SquaredEuclidean>(&(skew * site).to_array(), two);
+    let other = found.iter().find(|n| n.item as usize != k)?;
+    Some((other.item as usize, other.distance))
 }
 
 /// Lloyd iterations of each sibling-fill problem.
