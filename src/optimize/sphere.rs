@@ -1691,17 +1691,29 @@ fn separate(
                 let skew = skew();
                 // only movable sites are measured and pushed: a pair of
                 // fixed rows is the same at every step
-                let nearest: Vec<(usize, f64)> = sites
-                    .par_iter()
-                    .enumerate()
-                    .map(|(k, &site)| {
-                        if !movable[set[k].1] {
-                            return (k, f64::INFINITY);
-                        }
-                        nearest_other(&tree, skew, site, k)
-                            .map_or((k, f64::INFINITY), |(j, d2)| (j, d2.sqrt()))
-                    })
-                    .collect();
+                let search = |within: f64| -> Vec<(usize, f64)> {
+                    sites
+                        .par_iter()
+                        .enumerate()
+                        .map(|(k, &site)| {
+                            if !movable[set[k].1] {
+                                return (k, f64::INFINITY);
+                            }
+                            nearest_other(&tree, skew, site, k, within)
+                                .map_or((k, f64::INFINITY), |(j, d2)| (j, d2.sqrt()))
+                        })
+                        .collect()
+                };
+                // only a site closer than the goal is pushed, so the search
+                // stops at the goal's distance (a margin above its
+                // rounding), which prunes most of the tree: most sites
+                // have no neighbour that close. The smallest distance is
+                // then exact whenever one site is below the goal, else the
+                // set is searched again without the bound.
+                let mut nearest = search((goal / scale).powi(2) * (1.0 + 1e-6));
+                if nearest.iter().all(|&(_, d)| d * scale >= goal) {
+                    nearest = search(f64::INFINITY);
+                }
                 worst = nearest.iter().fold(worst, |w, &(_, d)| w.min(d * scale));
                 for (k, &(j, d)) in nearest.iter().enumerate() {
                     if d * scale >= goal {
@@ -1847,23 +1859,27 @@ fn inner_radii(tree: &ImmutableKdTree<f64, u32, 3, 32>, sites: &[DVec3]) -> Vec<
         .enumerate()
         .map(|(k, &site)| {
             // a twin at distance 0 gives 0
-            nearest_other(tree, skew, site, k)
+            nearest_other(tree, skew, site, k, f64::INFINITY)
                 .map_or(f64::INFINITY, |(_, d2)| d2 / 4.0 * (1.0 - 1e-9))
         })
         .collect()
 }
 
 /// The nearest of the sites in `tree` (see [`site_tree`], rotated by
-/// `skew`) to site `k`, at `site`, other than itself, and its squared distance; `None` if `k`
-/// is alone.
+/// `skew`) to site `k`, at `site`, other than itself, and its squared
+/// distance; `None` if no other lies within squared distance `within`
+/// (`f64::INFINITY`: if `k` is alone). A bound prunes the search; the
+/// sites it finds are the same.
 fn nearest_other(
     tree: &ImmutableKdTree<f64, u32, 3, 32>,
     skew: glam::DQuat,
     site: DVec3,
     k: usize,
+    within: f64,
 ) -> Option<(usize, f64)> {
     let two = std::num::NonZeroUsize::new(2).expect("2 > 0");
-    let found = tree.nearest_n::<SquaredEuclidean>(&(skew * site).to_array(), two);
+    let query = (skew * site).to_array();
+    let found = tree.nearest_n_within::<SquaredEuclidean>(&query, within, two, true);
     let other = found.iter().find(|n| n.item as usize != k)?;
     Some((other.item as usize, other.distance))
 }
