@@ -2465,6 +2465,39 @@ mod tests {
                 }
             }
         }
+
+        /// The separation steps' bounded search finds a site's nearest
+        /// other exactly when it lies within the bound, and nothing else.
+        #[test]
+        fn a_bounded_search_finds_the_nearest_other_within_its_bound(
+            sites in prop::collection::vec((-1.0f64..1.0, 0.0f64..std::f64::consts::TAU), 2..60),
+            bound in 0.0f64..1.0,
+            twin in any::<bool>(),
+        ) {
+            let on_sphere = |&(z, phi): &(f64, f64)| {
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            };
+            let mut sites: Vec<DVec3> = sites.iter().map(on_sphere).collect();
+            if twin {
+                sites.push(sites[0]);
+            }
+            let (tree, skew) = (site_tree(&sites), skew());
+            let within = bound * bound;
+            for (k, &site) in sites.iter().enumerate() {
+                let all = nearest_other(&tree, skew, site, k, f64::INFINITY).expect("2 sites");
+                let bounded = nearest_other(&tree, skew, site, k, within);
+                // the chosen site's distance, as the unbounded search
+                // measured it (a tie may pick another site)
+                match bounded {
+                    Some((_, d2)) => {
+                        prop_assert!(d2 <= within);
+                        prop_assert_eq!(d2, all.1);
+                    }
+                    None => prop_assert!(all.1 > within),
+                }
+            }
+        }
     }
 
     /// Level 1 relaxed one bin at a time crowds where two neighbouring
