@@ -2416,6 +2416,22 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// Points on the sphere from `(z, phi)` pairs, the first repeated at
+    /// the end if `twin`.
+    fn on_sphere(pairs: &[(f64, f64)], twin: bool) -> Vec<DVec3> {
+        let mut points: Vec<DVec3> = pairs
+            .iter()
+            .map(|&(z, phi)| {
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            })
+            .collect();
+        if twin {
+            points.push(points[0]);
+        }
+        points
+    }
+
     proptest! {
         /// A coarser grid stores multiples of its step within half a step
         /// of the offset, and a step of 1 is the table's own grid.
@@ -2443,20 +2459,13 @@ mod tests {
             queries in prop::collection::vec((-1.0f64..1.0, 0.0f64..std::f64::consts::TAU), 1..200),
             twin in any::<bool>(),
         ) {
-            let on_sphere = |&(z, phi): &(f64, f64)| {
-                let r = (1.0 - z * z).sqrt();
-                DVec3::new(r * phi.cos(), r * phi.sin(), z)
-            };
-            let mut sites: Vec<DVec3> = sites.iter().map(on_sphere).collect();
-            if twin {
-                sites.push(sites[0]);
-            }
+            let sites = on_sphere(&sites, twin);
             let tree = site_tree(&sites);
             let owns = inner_radii(&tree, &sites);
             if twin {
                 prop_assert_eq!(owns[0], 0.0);
             }
-            for q in queries.iter().map(on_sphere) {
+            for q in on_sphere(&queries, false) {
                 let nearest = tree.nearest_one::<SquaredEuclidean>(&(skew() * q).to_array());
                 for (k, &site) in sites.iter().enumerate() {
                     if q.distance_squared(site) < owns[k] {
@@ -2474,14 +2483,7 @@ mod tests {
             bound in 0.0f64..1.0,
             twin in any::<bool>(),
         ) {
-            let on_sphere = |&(z, phi): &(f64, f64)| {
-                let r = (1.0 - z * z).sqrt();
-                DVec3::new(r * phi.cos(), r * phi.sin(), z)
-            };
-            let mut sites: Vec<DVec3> = sites.iter().map(on_sphere).collect();
-            if twin {
-                sites.push(sites[0]);
-            }
+            let sites = on_sphere(&sites, twin);
             let (tree, skew) = (site_tree(&sites), skew());
             let within = bound * bound;
             for (k, &site) in sites.iter().enumerate() {
