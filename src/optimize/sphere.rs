@@ -1867,9 +1867,9 @@ fn inner_radii(tree: &ImmutableKdTree<f64, u32, 3, 32>, sites: &[DVec3]) -> Vec<
 
 /// The nearest of the sites in `tree` (see [`site_tree`], rotated by
 /// `skew`) to site `k`, at `site`, other than itself, and its squared
-/// distance; `None` if no other lies within squared distance `within`
-/// (`f64::INFINITY`: if `k` is alone). A bound prunes the search; the
-/// sites it finds are the same.
+/// distance; `None` if no other site lies within squared distance
+/// `within` (with `f64::INFINITY`, only if `k` is alone). A finite bound
+/// prunes the search without changing what it finds inside the bound.
 fn nearest_other(
     tree: &ImmutableKdTree<f64, u32, 3, 32>,
     skew: glam::DQuat,
