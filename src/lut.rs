@@ -5,8 +5,10 @@
 //! parameters and resulting metrics. `tessera lut build` regenerates both.
 
 mod drop_moves;
+mod zonal_warp;
 
 pub use drop_moves::{DropMoves, MOST_MOVES_A_ROW};
+pub use zonal_warp::ZonalWarp;
 
 use crate::polyomino::{Lattice, Placement, Rule};
 use crate::Error;
@@ -37,7 +39,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 9;
+pub const SPHERE_LUT_VERSION: u32 = 10;
 
 /// Of the bins stored as differences from the bin below (see
 /// `SphereLut::chained`), every this many is stored whole, so that a
@@ -138,6 +140,12 @@ pub struct SphereLut {
     /// builder moved them, dropping the bin's codes from the top. Where a
     /// level has fills too (level 6), a move takes precedence over a fill.
     pub drop_moves: Vec<Vec<DropMoves>>,
+    /// Zonal warps of the first per-tile levels, per level and bin
+    /// (levels from `zonal_warps.len()` on have none; see [`ZonalWarp`]):
+    /// every point a bin places on the level moves by its bin's warp.
+    /// Stored in the file's last frame.
+    #[serde(skip)]
+    pub zonal_warps: Vec<Vec<ZonalWarp>>,
 }
 
 /// One offset table (`i8` pairs, see [`SphereLut::tables`]), kept in its
@@ -516,7 +524,7 @@ impl SphereLut {
     /// The file is zstd frames: the table with its offset tables empty,
     /// then each of `tables` (level by level, bin by bin), then each of
     /// `fills`, as raw pairs, then each of `drop_moves` (level by level,
-    /// bin by bin; see [`DropMoves`]).
+    /// bin by bin; see [`DropMoves`]), then the `zonal_warps`.
     fn read(bytes: &[u8]) -> Result<Self, Error> {
         let mut frames = Frames(bytes);
         let header = decompress(frames.next().unwrap_or(bytes))?;
@@ -550,6 +558,12 @@ impl SphereLut {
             })?;
             *moves = DropMoves::packed(frame);
         }
+        let warps = frames.next().ok_or_else(|| {
+            Error::Table("sphere table does not decompress: it ends before its zonal warps".into())
+        })?;
+        lut.zonal_warps = postcard::from_bytes(&decompress(warps)?).map_err(|e| {
+            Error::Table(format!("sphere table: its zonal warps do not decode: {e}"))
+        })?;
         Ok(lut)
     }
 
@@ -622,6 +636,12 @@ impl SphereLut {
         for moves in self.drop_moves.iter().flatten() {
             bytes.extend(moves.compress());
         }
+        let warps =
+            postcard::to_allocvec(&self.zonal_warps).expect("serialising to memory cannot fail");
+        bytes.extend(
+            zstd::bulk::compress(&warps, SPHERE_LUT_ZSTD_LEVEL)
+                .expect("compressing in memory cannot fail"),
+        );
         bytes
     }
 
@@ -960,7 +980,39 @@ impl SphereLut {
                 }
             }
         }
+        if self.zonal_warps.len() > self.exact_levels as usize {
+            return bad("zonal warps past the tree-indexed levels");
+        }
+        for (level, warps) in self.zonal_warps.iter().enumerate() {
+            if warps.len() != self.bins() {
+                return bad(&format!(
+                    "zonal warps of level {level} have the wrong number of bins"
+                ));
+            }
+            // a slope of 1/2 at most keeps latitudes in order with room
+            let wild = |w: &ZonalWarp| w.slope_bound().is_nan() || w.slope_bound() > 0.5;
+            if let Some(bin) = warps.iter().position(wild) {
+                return bad(&format!(
+                    "the zonal warp of level {level} bin {bin} is not finite or moves points past each other"
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// The zonal warp every point the tiles of `level` place in bin `bin`
+    /// moves by: the identity where the table has none.
+    ///
+    /// # Example
+    /// ```
+    /// let lut = tessera::lut::sphere_lut();
+    /// assert!(lut.zonal_warp(lut.exact_levels as usize, 0).is_identity());
+    /// ```
+    pub fn zonal_warp(&self, level: usize, bin: usize) -> ZonalWarp {
+        (self.zonal_warps.get(level))
+            .and_then(|warps| warps.get(bin))
+            .copied()
+            .unwrap_or_default()
     }
 }
 

@@ -345,12 +345,18 @@ impl SphereTiling {
     /// assert!(tessera::polyomino::Shape::p_pentomino().contains(o));
     /// ```
     pub fn offset(&self, tile: &SphereTile, fraction: f64) -> [f64; 2] {
+        self.offset_in_bin(tile, fraction).0
+    }
+
+    /// [`SphereTiling::offset`], with the importance bin it reads.
+    fn offset_in_bin(&self, tile: &SphereTile, fraction: f64) -> ([f64; 2], usize) {
         let lut = &*self.lut;
         let (level, capacity) = (tile.level as u32, self.capacity(tile.level as u32));
         let bin = lut.bin(fraction, capacity);
         let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
         let offsets = lut.request_offsets(level, fraction, capacity, bin);
-        offsets.placed(tile.index as usize, tile.code as u64, shares)
+        let offset = offsets.placed(tile.index as usize, tile.code as u64, shares);
+        (offset, bin)
     }
 
     /// The shape of every tile.
@@ -592,13 +598,13 @@ impl TileSystem for SphereTiling {
         let capacity = self.capacity(level);
         let bin = lut.bin(fraction, capacity);
         let offsets = lut.request_offsets(level, fraction, capacity, bin);
+        let warp = lut.zonal_warp(level as usize, bin);
         let place = move |t: &code_order::Placed, code: usize| {
             let shares = |lost| twins_share_a_hole(self, lut, (level, bin), lost);
-            sample(
-                t,
-                code,
-                offsets.placed(t.class as usize, code as u64, shares),
-            )
+            let offset = offsets.placed(t.class as usize, code as u64, shares);
+            let mut placed = sample(t, code, offset);
+            placed.position = warp.apply(placed.position);
+            placed
         };
         let source = Listed::new(self, list, listed_codes.start, m, depth, indexing, place);
         Some(Box::new(source))
@@ -621,7 +627,9 @@ impl TileSystem for SphereTiling {
     }
 
     fn sample(&self, tile: &SphereTile, fraction: f64) -> DVec3 {
-        self.face_point(tile, self.offset(tile, fraction)).to_vec()
+        let (offset, bin) = self.offset_in_bin(tile, fraction);
+        let warp = self.lut.zonal_warp(tile.level as usize, bin);
+        warp.apply(self.face_point(tile, offset).to_vec())
     }
 }
 
