@@ -66,6 +66,27 @@ fn bad_tables_are_refused_with_a_reason() {
     unshared.ring_from = unshared.exact_levels;
     let level = sphere_lut().ring_from;
     assert!(err(&unshared.to_bytes()).contains(&format!("offset table {level} has the wrong size")));
+    // zonal warps: one that would swap latitudes, a bin missing, and a
+    // file cut before them
+    let mut wild = (*sphere_lut()).clone();
+    wild.zonal_warps[2][5] = tessera::lut::ZonalWarp::new([0.0, 0.3, 0.0, 0.0, 0.0, 0.0]);
+    assert!(err(&wild.to_bytes()).contains("zonal warp of level 2 bin 5"));
+    let mut missing = (*sphere_lut()).clone();
+    missing.zonal_warps[3].pop();
+    assert!(err(&missing.to_bytes()).contains("zonal warps of level 3 have the wrong number"));
+    let moves_end = bytes.len() - last_frame_len(&bytes);
+    assert!(err(&bytes[..moves_end]).contains("ends before its zonal warps"));
+}
+
+/// The length of the last zstd frame of `bytes` (a table's frames).
+fn last_frame_len(bytes: &[u8]) -> usize {
+    let mut rest = bytes;
+    let mut last = 0;
+    while !rest.is_empty() {
+        last = zstd::zstd_safe::find_frame_compressed_size(rest).unwrap();
+        rest = &rest[last..];
+    }
+    last
 }
 
 #[test]
