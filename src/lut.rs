@@ -949,15 +949,8 @@ impl SphereLut {
                 ));
             }
         }
-        if self.drop_moves.len() > self.exact_levels as usize {
-            return bad("drop moves past the tree-indexed levels");
-        }
+        self.check_per_bin("drop-move", &self.drop_moves)?;
         for (level, bins) in self.drop_moves.iter().enumerate() {
-            if bins.len() != self.bins() {
-                return bad(&format!(
-                    "drop-move table {level} has the wrong number of bins"
-                ));
-            }
             let capacity = (ROOT_COUNT << (2 * level)) as f64;
             for (bin, moves) in bins.iter().enumerate() {
                 // keys count from the lower bin's count, below this bin's
@@ -980,15 +973,8 @@ impl SphereLut {
                 }
             }
         }
-        if self.zonal_warps.len() > self.exact_levels as usize {
-            return bad("zonal warps past the tree-indexed levels");
-        }
+        self.check_per_bin("zonal-warp", &self.zonal_warps)?;
         for (level, warps) in self.zonal_warps.iter().enumerate() {
-            if warps.len() != self.bins() {
-                return bad(&format!(
-                    "zonal warps of level {level} have the wrong number of bins"
-                ));
-            }
             // a slope of 1/2 at most keeps latitudes in order with room
             let wild = |w: &ZonalWarp| w.slope_bound().is_nan() || w.slope_bound() > 0.5;
             if let Some(bin) = warps.iter().position(wild) {
@@ -998,6 +984,19 @@ impl SphereLut {
             }
         }
         Ok(())
+    }
+
+    /// Checks that `tables` (one per level from 0, a `kind` table per
+    /// bin) stop at the tree-indexed levels and hold every bin.
+    fn check_per_bin<T>(&self, kind: &str, tables: &[Vec<T>]) -> Result<(), Error> {
+        let bad = |what: String| Err(Error::Table(format!("sphere table: {what}")));
+        if tables.len() > self.exact_levels as usize {
+            return bad(format!("{kind} tables past the tree-indexed levels"));
+        }
+        match tables.iter().position(|bins| bins.len() != self.bins()) {
+            Some(level) => bad(format!("{kind} table {level} has the wrong number of bins")),
+            None => Ok(()),
+        }
     }
 
     /// The zonal warp every point the tiles of `level` place in bin `bin`

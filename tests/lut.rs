@@ -73,7 +73,7 @@ fn bad_tables_are_refused_with_a_reason() {
     assert!(err(&wild.to_bytes()).contains("zonal warp of level 2 bin 5"));
     let mut missing = (*sphere_lut()).clone();
     missing.zonal_warps[3].pop();
-    assert!(err(&missing.to_bytes()).contains("zonal warps of level 3 have the wrong number"));
+    assert!(err(&missing.to_bytes()).contains("zonal-warp table 3 has the wrong number of bins"));
     let moves_end = bytes.len() - last_frame_len(&bytes);
     assert!(err(&bytes[..moves_end]).contains("ends before its zonal warps"));
 }
