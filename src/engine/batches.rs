@@ -28,7 +28,7 @@ const BATCH_SAMPLES: usize = 1 << 19;
 /// count's search for the request's magnitude takes such passes too), the
 /// second writes those below the cut bucket as they come and keeps the
 /// cut bucket's (about `count / 4096` of them) to write last, in rank
-/// order. A constant density streams its codes ([`stream`]).
+/// order. A constant density streams its codes ([`stream()`]).
 ///
 /// # Example
 /// ```

@@ -134,7 +134,7 @@ pub(super) struct Walker<'a, S: TileSystem, D: ?Sized> {
     least_dither: f64,
     /// The dither's seed ([`Density::seed`]).
     seed: u64,
-    /// Only tiles this accepts are visited (see [`collect_within`]).
+    /// Only tiles this accepts are visited (see [`super::collect_within`]).
     window: Option<&'a Window<'a, S::Region>>,
 }
 impl<'a, S, D> Walker<'a, S, D>
