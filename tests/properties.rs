@@ -98,10 +98,21 @@ impl<T: TileSystem, F: Fn(&T, &T::Tile, T::Point, f64) -> bool + Sync> TileSyste
     }
 }
 
-/// Whether a sphere sample lies in its tile's room: the pentomino at full
-/// density, below it the pentomino grown by three cells (the offset tables
-/// keep to one, drop moves to three).
+/// Whether a sphere sample lies in its tile's room: its offset's point in
+/// the pentomino at full density, below it in the pentomino grown by three
+/// cells (the offset tables keep to one, drop moves to three), and the
+/// sample within its bin's zonal warp of that point (at most 0.08
+/// spacings of the bin's top count, at least a quarter of the level).
 fn in_pentomino_room(tiling: &SphereTiling, tile: &SphereTile, p: DVec3, fraction: f64) -> bool {
+    let placed = tiling
+        .face_point(tile, tiling.offset(tile, fraction))
+        .to_vec();
+    let quarter_level = 0.25 * tiling.capacity(tile.level as u32);
+    let warp_reach = 0.08 * (4.0 * PI / quarter_level).sqrt() * (1.0 + 1e-9);
+    if angle_between(p, placed) > warp_reach {
+        return false;
+    }
+    let p = placed;
     let fp = FacePoint::from_vec(p);
     let nside = SphereTiling::nside(tile.level as u32) as f64;
     if fp.face != tile.face {
