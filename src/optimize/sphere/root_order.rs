@@ -30,9 +30,9 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Zonal harmonics the objective weighs (their weights fall as `1/l²`).
-const DEGREES: usize = 8;
+pub(super) const DEGREES: usize = 8;
 /// `P_1..P_DEGREES` summed over some tiles.
-type Moments = [f64; DEGREES];
+pub(super) type Moments = [f64; DEGREES];
 /// A level and a count's quotient by 240.
 type Quotient = (usize, usize);
 /// Counts the objective samples, log-spaced from 100 to [`COUNTS_UP_TO`].
@@ -261,7 +261,7 @@ fn add(a: &mut Moments, b: &Moments) {
 }
 
 /// `P_1(z)..P_DEGREES(z)` by Bonnet's recursion.
-fn legendre(z: f64) -> Moments {
+pub(super) fn legendre(z: f64) -> Moments {
     let mut out: Moments = [0.0; DEGREES];
     let (mut previous, mut current) = (1.0, z);
     out[0] = z;

@@ -8,6 +8,7 @@
 //! to 1.29 at 96,172; the normalised Riesz energy and the separation moved
 //! by under 0.0002 and 0.002, the largest move 2 % of a spacing.
 
+use super::root_order::{legendre, DEGREES};
 use super::Progress;
 use crate::density::Uniform;
 use crate::engine;
@@ -19,8 +20,6 @@ use std::sync::Arc;
 /// Terms of a warp's series.
 const TERMS: usize = ZonalWarp::TERMS;
 
-/// Zonal moments `M_l = Σ P_l(z_i)`, `l = 1..=DEGREES`, a warp evens out.
-const DEGREES: usize = 8;
 /// Uniform counts a bin's warp is fitted on, at most (evenly spread over
 /// the counts it serves, its top one included).
 const COUNTS_A_BIN: usize = 24;
@@ -45,14 +44,11 @@ fn weight(l: usize, n: usize) -> f64 {
     1.0 / ((2.0 * l - 1.0) * (2.0 * l + 3.0) * (n as f64).sqrt())
 }
 
-/// `P_0(z) ..= P_DEGREES(z)`.
+/// `P_0(z) ..= P_DEGREES(z)`: the root ranks' (whose degrees these are)
+/// after `P_0 = 1`.
 fn legendre_all(z: f64) -> [f64; DEGREES + 1] {
-    let mut p = [0.0; DEGREES + 1];
-    p[0] = 1.0;
-    p[1] = z;
-    for l in 1..DEGREES {
-        p[l + 1] = ((2 * l + 1) as f64 * z * p[l] - l as f64 * p[l - 1]) / (l + 1) as f64;
-    }
+    let mut p = [1.0; DEGREES + 1];
+    p[1..].copy_from_slice(&legendre(z));
     p
 }
 
