@@ -628,8 +628,14 @@ impl TileSystem for SphereTiling {
 
     fn sample(&self, tile: &SphereTile, fraction: f64) -> DVec3 {
         let (offset, bin) = self.offset_in_bin(tile, fraction);
+        let p = self.face_point(tile, offset).to_vec();
+        // the class levels, and bins no uniform request reads, have none
         let warp = self.lut.zonal_warp(tile.level as usize, bin);
-        warp.apply(self.face_point(tile, offset).to_vec())
+        if warp.is_identity() {
+            p
+        } else {
+            warp.apply(p)
+        }
     }
 }
 
