@@ -17,7 +17,8 @@
 //! and a guard (`optimize::sphere::drop_moves`).
 //!
 //! For each bin interval of a level it prints separation, covering and
-//! mesh ratio (times √N) at `--evaluate` counts spread over the interval,
+//! mesh ratio (times √N) and the normalised energy (issue 18's floors:
+//! 2.4, 3.4, 2.8 and -1.085) at `--evaluate` counts spread over the interval,
 //! the shipped table (drop moves on levels 0-5, sibling fills on 6)
 //! against the simulation, then the level's worst, its events a tile and
 //! what they would take in a table (per tile, uncompressed and zstd: a
@@ -31,7 +32,7 @@
 use glam::DVec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::f64::consts::PI;
-use tessera::metrics::sphere::{covering_radius, separation};
+use tessera::metrics::sphere::{covering_radius, riesz1_normalized, separation};
 use tessera::relax::relax_among_fixed;
 use tessera::tiling::{sphere::SphereTiling, TileSystem};
 use tessera::Sampler;
@@ -54,27 +55,28 @@ struct Settings {
     evaluate: usize,
 }
 
-/// Separation, covering radius and mesh ratio, times √N.
+/// Separation, covering radius and mesh ratio, times √N, and the
+/// normalised Riesz s = 1 energy `(E - N²) / N^1.5`.
 #[derive(Clone, Copy)]
-struct Quality([f64; 3]);
+struct Quality([f64; 4]);
 
 impl Quality {
     fn of(points: &[DVec3]) -> Self {
         let (s, c) = (separation(points), covering_radius(points));
-        Quality([s, c, 2.0 * c / s])
+        Quality([s, c, 2.0 * c / s, riesz1_normalized(points)])
     }
 
     fn worst(self, other: Self) -> Self {
-        let [s, c, m] = self.0;
-        let [t, d, n] = other.0;
-        Quality([s.min(t), c.max(d), m.max(n)])
+        let [s, c, m, e] = self.0;
+        let [t, d, n, f] = other.0;
+        Quality([s.min(t), c.max(d), m.max(n), e.max(f)])
     }
 }
 
 impl std::fmt::Display for Quality {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        let [s, c, m] = self.0;
-        write!(f, "{s:.2} / {c:.2} / {m:.2}")
+        let [s, c, m, e] = self.0;
+        write!(f, "{s:.2} / {c:.2} / {m:.2} / {e:.4}")
     }
 }
 
@@ -105,7 +107,10 @@ fn main() {
         false => bins.to_vec(),
     };
     let capacity = sphere.capacity(level as u32);
-    let (mut shipped, mut simulated) = (Quality([f64::INFINITY, 0.0, 0.0]), None::<Quality>);
+    let (mut shipped, mut simulated) = (
+        Quality([f64::INFINITY, 0.0, 0.0, f64::NEG_INFINITY]),
+        None::<Quality>,
+    );
     let (mut events, mut table) = (0, Vec::new());
     for bin in bins {
         let interval = Interval::new(&sphere, capacity, bin);
@@ -128,7 +133,7 @@ fn main() {
     );
     if let Some(simulated) = simulated {
         println!(
-            "worst (separation / covering / mesh ratio): shipped {shipped}, events {simulated}"
+            "worst (separation / covering / mesh ratio / energy): shipped {shipped}, events {simulated}"
         );
     }
 }

@@ -39,7 +39,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 10;
+pub const SPHERE_LUT_VERSION: u32 = 11;
 
 /// Of the bins stored as differences from the bin below (see
 /// `SphereLut::chained`), every this many is stored whole, so that a
@@ -849,8 +849,18 @@ impl SphereLut {
         })
     }
 
-    /// Checks every index the run-time recursion will follow.
-    fn validate(&self) -> Result<(), Error> {
+    /// Checks every index the run-time recursion will follow and every
+    /// offset's room: what [`SphereLut::from_bytes`] checks of a file,
+    /// for a table built or edited in memory.
+    ///
+    /// # Example
+    /// ```
+    /// let mut lut = (*tessera::lut::sphere_lut()).clone();
+    /// lut.transitions[0][0] = u32::MAX; // an automaton pointing nowhere
+    /// let e = lut.validate().unwrap_err().to_string();
+    /// assert!(e.contains("missing class"), "{e}");
+    /// ```
+    pub fn validate(&self) -> Result<(), Error> {
         let bad = |what: &str| Err(Error::Table(format!("sphere table: {what}")));
         let roots = ROOT_COUNT;
         if self.rules.len() != 2 || self.rules.iter().any(|r| r.children.len() != 4) {

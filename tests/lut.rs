@@ -5,7 +5,10 @@ use tessera::lut::{sphere_lut, SphereLut, SPHERE_LUT_VERSION};
 #[test]
 fn the_shipped_table_round_trips() {
     let lut = sphere_lut();
-    assert_eq!(SphereLut::from_bytes(&lut.to_bytes()).unwrap(), *lut);
+    let bytes = lut.to_bytes();
+    assert_eq!(SphereLut::from_bytes(&bytes).unwrap(), *lut);
+    // byte for byte: the file is what `tessera lut build` writes for it
+    assert!(bytes == include_bytes!("../luts/sphere.lut"));
 }
 
 #[test]
@@ -17,7 +20,7 @@ fn the_embedded_table_is_valid() {
 }
 
 #[test]
-fn bad_tables_are_refused_with_a_reason() {
+fn bad_files_are_refused_with_a_reason() {
     let bytes = sphere_lut().to_bytes();
     let err = |b: &[u8]| SphereLut::from_bytes(b).unwrap_err().to_string();
     assert!(err(&[]).contains("version 0"));
@@ -28,13 +31,27 @@ fn bad_tables_are_refused_with_a_reason() {
     // an uncompressed table of an earlier format names its version
     assert!(err(&[5, 0, 0]).contains("version 5"));
     assert!(err(&bytes[..bytes.len() / 2]).contains("does not decompress"));
-    // a table whose automaton points nowhere
+    let moves_end = bytes.len() - last_frame_len(&bytes);
+    assert!(err(&bytes[..moves_end]).contains("ends before its zonal warps"));
+    // a file that decodes is checked as a table in memory is (below)
     let mut broken = (*sphere_lut()).clone();
     broken.transitions[0][0] = u32::MAX;
     assert!(err(&broken.to_bytes()).contains("missing class"));
+}
+
+#[test]
+fn bad_tables_are_refused_with_a_reason() {
+    // what `SphereLut::from_bytes` checks once a file decodes, without
+    // encoding each case (6 s each at zstd level 22)
+    let err = |lut: &SphereLut| lut.validate().unwrap_err().to_string();
+    assert!(sphere_lut().validate().is_ok());
+    // a table whose automaton points nowhere
+    let mut broken = (*sphere_lut()).clone();
+    broken.transitions[0][0] = u32::MAX;
+    assert!(err(&broken).contains("missing class"));
     let mut far = (*sphere_lut()).clone();
     far.tables[0][0][0] = [i8::MAX, 0];
-    assert!(err(&far.to_bytes()).contains("outside"));
+    assert!(err(&far).contains("outside"));
     // the first level with sibling fills (those before have drop moves)
     let fills = (sphere_lut().fills.iter())
         .position(|fills| !fills.is_empty())
@@ -42,40 +59,37 @@ fn bad_tables_are_refused_with_a_reason() {
     let mut short = (*sphere_lut()).clone();
     short.fills[fills].pop();
     let expected = format!("sibling-fill table {fills} has the wrong size");
-    assert!(err(&short.to_bytes()).contains(&expected));
+    assert!(err(&short).contains(&expected));
     let mut far_fill = (*sphere_lut()).clone();
     far_fill.fills[fills][0] = [0, i8::MIN];
     let expected = format!("sibling-fill table {fills} has an offset outside");
-    assert!(err(&far_fill.to_bytes()).contains(&expected));
+    assert!(err(&far_fill).contains(&expected));
     // drop moves: a row too few, and a key past its bin
     let mut fewer = (*sphere_lut()).clone();
     let rows: Vec<Vec<(u16, [i8; 2], u8)>> = vec![Vec::new(); fewer.rows(1) - 1];
     fewer.drop_moves[1][3] = tessera::lut::DropMoves::from_rows(rows);
-    assert!(err(&fewer.to_bytes()).contains("drop-move table 1 bin 3 has the wrong size"));
+    assert!(err(&fewer).contains("drop-move table 1 bin 3 has the wrong size"));
     let mut past = (*sphere_lut()).clone();
     let mut rows: Vec<Vec<(u16, [i8; 2], u8)>> = vec![Vec::new(); past.rows(1)];
     rows[0].push((u16::MAX, [0, 0], 0));
     past.drop_moves[1][3] = tessera::lut::DropMoves::from_rows(rows);
-    assert!(err(&past.to_bytes()).contains("a key past its bin"));
+    assert!(err(&past).contains("a key past its bin"));
     // ring-shared rows past the tree-indexed levels, and a table sized for
     // the wrong sharing
     let mut ring = (*sphere_lut()).clone();
     ring.ring_from = ring.exact_levels + 1;
-    assert!(err(&ring.to_bytes()).contains("ring_from"));
+    assert!(err(&ring).contains("ring_from"));
     let mut unshared = (*sphere_lut()).clone();
     unshared.ring_from = unshared.exact_levels;
     let level = sphere_lut().ring_from;
-    assert!(err(&unshared.to_bytes()).contains(&format!("offset table {level} has the wrong size")));
-    // zonal warps: one that would swap latitudes, a bin missing, and a
-    // file cut before them
+    assert!(err(&unshared).contains(&format!("offset table {level} has the wrong size")));
+    // zonal warps: one that would swap latitudes, and a bin missing
     let mut wild = (*sphere_lut()).clone();
     wild.zonal_warps[2][5] = tessera::lut::ZonalWarp::new([0.0, 0.3, 0.0, 0.0, 0.0, 0.0]);
-    assert!(err(&wild.to_bytes()).contains("zonal warp of level 2 bin 5"));
+    assert!(err(&wild).contains("zonal warp of level 2 bin 5"));
     let mut missing = (*sphere_lut()).clone();
     missing.zonal_warps[3].pop();
-    assert!(err(&missing.to_bytes()).contains("zonal-warp table 3 has the wrong number of bins"));
-    let moves_end = bytes.len() - last_frame_len(&bytes);
-    assert!(err(&bytes[..moves_end]).contains("ends before its zonal warps"));
+    assert!(err(&missing).contains("zonal-warp table 3 has the wrong number of bins"));
 }
 
 /// The length of the last zstd frame of `bytes` (a table's frames).
