@@ -8,7 +8,7 @@
 //!
 //! `--table` reads another sphere table (`tessera lut build --out-dir`).
 
-use tessera::lut::SphereLut;
+use tessera::lut::{frame_sizes, SphereLut};
 
 const USAGE: &str = "usage: table_budget [--table PATH]";
 
@@ -24,15 +24,7 @@ fn main() {
     };
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let lut = SphereLut::from_bytes(&bytes).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut frames = Vec::new();
-    let mut rest = &bytes[..];
-    while !rest.is_empty() {
-        let size = zstd::zstd_safe::find_frame_compressed_size(rest)
-            .unwrap_or_else(|e| panic!("{path}: not a zstd frame ({e})"));
-        frames.push(size);
-        rest = &rest[size..];
-    }
-    let mut sizes = frames.into_iter();
+    let mut sizes = frame_sizes(&bytes).into_iter();
     let mut take = |count: usize| -> usize { sizes.by_ref().take(count).sum() };
     let mut parts: Vec<(String, usize, String)> = vec![("header".into(), take(1), String::new())];
     for (level, bins) in lut.tables.iter().enumerate() {
@@ -60,7 +52,8 @@ fn main() {
         );
         parts.push((format!("drop moves, level {level}"), size, each));
     }
-    parts.push(("zonal warps".into(), take(usize::MAX), String::new()));
+    parts.push(("zonal warps".into(), take(1), String::new()));
+    assert_eq!(sizes.next(), None, "{path}: more frames than its parts");
     println!("{path}: {} bytes\n", bytes.len());
     println!("| part | bytes | share | holds |");
     println!("|---|---|---|---|");

@@ -1092,6 +1092,22 @@ pub fn bin_fractions(count: usize) -> Vec<f64> {
     fractions
 }
 
+/// The sizes of the zstd frames a sphere table file is made of, in order
+/// (see [`SphereLut::to_bytes`] for what each holds); a tail that is not
+/// a whole frame counts as one.
+///
+/// # Example
+/// ```
+/// let mut bytes = zstd::bulk::compress(b"header", 1).unwrap();
+/// let first = bytes.len();
+/// bytes.extend(zstd::bulk::compress(b"offsets", 1).unwrap());
+/// let sizes = tessera::lut::frame_sizes(&bytes);
+/// assert_eq!(sizes, [first, bytes.len() - first]);
+/// ```
+pub fn frame_sizes(bytes: &[u8]) -> Vec<usize> {
+    Frames(bytes).map(<[u8]>::len).collect()
+}
+
 /// The zstd frames of a sphere table file, in order; what does not parse
 /// as a frame comes as one last piece, for [`decompress`] to refuse.
 struct Frames<'a>(&'a [u8]);

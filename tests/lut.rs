@@ -1,6 +1,6 @@
 //! Table files: round trip, and clear errors for bad ones.
 
-use tessera::lut::{sphere_lut, SphereLut, SPHERE_LUT_VERSION};
+use tessera::lut::{frame_sizes, sphere_lut, SphereLut, SPHERE_LUT_VERSION};
 
 #[test]
 fn the_shipped_table_round_trips() {
@@ -31,7 +31,7 @@ fn bad_files_are_refused_with_a_reason() {
     // an uncompressed table of an earlier format names its version
     assert!(err(&[5, 0, 0]).contains("version 5"));
     assert!(err(&bytes[..bytes.len() / 2]).contains("does not decompress"));
-    let moves_end = bytes.len() - last_frame_len(&bytes);
+    let moves_end = bytes.len() - frame_sizes(&bytes).last().expect("frames");
     assert!(err(&bytes[..moves_end]).contains("ends before its zonal warps"));
     // a file that decodes is checked as a table in memory is (below)
     let mut broken = (*sphere_lut()).clone();
@@ -90,17 +90,6 @@ fn bad_tables_are_refused_with_a_reason() {
     let mut missing = (*sphere_lut()).clone();
     missing.zonal_warps[3].pop();
     assert!(err(&missing).contains("zonal-warp table 3 has the wrong number of bins"));
-}
-
-/// The length of the last zstd frame of `bytes` (a table's frames).
-fn last_frame_len(bytes: &[u8]) -> usize {
-    let mut rest = bytes;
-    let mut last = 0;
-    while !rest.is_empty() {
-        last = zstd::zstd_safe::find_frame_compressed_size(rest).unwrap();
-        rest = &rest[last..];
-    }
-    last
 }
 
 #[test]
