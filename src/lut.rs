@@ -39,7 +39,7 @@ pub const ROOT_COUNT: usize = 12 * ROOTS_PER_FACE;
 pub const MAX_CELLS: usize = 8;
 
 /// Format version written into and required from sphere tables.
-pub const SPHERE_LUT_VERSION: u32 = 11;
+pub const SPHERE_LUT_VERSION: u32 = 12;
 
 /// Of the bins stored as differences from the bin below (see
 /// `SphereLut::chained`), every this many is stored whole, so that a
@@ -329,8 +329,9 @@ impl LevelOffsets<'_> {
         // (level 6 has both) its sibling fill
         let moved = (self.moves)
             .and_then(|(moves, dropped_from, ring)| {
-                moves.offset(row, dropped_from, ring.then_some((code & 3) as u8))
+                moves.shift(row, dropped_from, ring.then_some((code & 3) as u8))
             })
+            .map(|shift| [0, 1].map(|c| self.table[row][c].wrapping_add(shift[c])))
             .or_else(|| {
                 let (fills, counts) = self.fills.as_ref()?;
                 (counts.pair(code, shares_a_hole))

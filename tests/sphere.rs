@@ -523,6 +523,19 @@ fn zonal_warps_bring_the_cap_discrepancy_between_bins_under_issue_18s_floor() {
     }
 }
 
+/// Level 4's drop moves reach 2.0 spacings about a hole (1.5 on the
+/// other levels): at its sweep counts between bins the normalised energy
+/// meets issue 18's floor, where a reach of 1.5 read -1.0826 at N =
+/// 20,188 and -1.0845 at 51,507.
+#[test]
+fn level_4s_wider_drop_moves_meet_issue_18s_energy_floor_between_bins() {
+    use tessera::metrics::sphere::riesz1_normalized;
+    for n in [20_188, 23_598, 37_694, 51_507] {
+        let energy = riesz1_normalized(&uniform_points(n));
+        assert!(energy <= -1.085, "N = {n}: energy {energy:.4}");
+    }
+}
+
 #[test]
 fn counts_are_exact_for_awkward_n() {
     for n in [0usize, 1, 2, 3, 239, 241, 1001, 4097] {

@@ -5,7 +5,8 @@
 //! about one spacing wide. The builder drops the bin's codes one at a time
 //! from the top, as ever smaller requests drop them, and each drop moves
 //! the kept points beside the hole (Lloyd among the others held fixed):
-//! a move records the point's new offset, keyed by the dropped code. A
+//! a move records the point's shift from its bin offset, keyed by the
+//! dropped code. A
 //! request then reads, for each point, the move of the lowest code it
 //! drops, so its set is the builder's state after dropping exactly its
 //! codes: the holes close as a relaxed set of its own count would have
@@ -21,8 +22,9 @@ pub const MOST_MOVES_A_ROW: usize = u8::MAX as usize;
 
 /// One level's moves in one importance bin, per offset row: each a key,
 /// the dropped code less the lower bin's count (`codes below the key's
-/// code` kept, from it up dropped), the offset (as the offset tables store
-/// them) the row's point then takes, and where rows are shared by a ring's
+/// code` kept, from it up dropped), the shift the row's point then takes
+/// from the bin's offset (in the offset tables' units, added wrapping as
+/// `i8`s do), and where rows are shared by a ring's
 /// four faces, which face of the ring (turning from the point's) the
 /// dropped code lies on; keys increase along a row. Kept in its zstd frame
 /// until first read, as [`super::Offsets`] are.
@@ -30,7 +32,7 @@ pub const MOST_MOVES_A_ROW: usize = u8::MAX as usize;
 /// At the ring-shared levels a move is keyed by the dropped ring orbit
 /// (codes equal but for the last two bits, one on each face), counted
 /// from the orbit of the lower bin's count: a request that splits the
-/// orbit drops its twin on some faces only, and [`DropMoves::offset`]
+/// orbit drops its twin on some faces only, and [`DropMoves::shift`]
 /// reads the move where the twin beside the point is dropped.
 ///
 /// # Example
@@ -38,15 +40,15 @@ pub const MOST_MOVES_A_ROW: usize = u8::MAX as usize;
 /// use tessera::lut::DropMoves;
 /// let moves = DropMoves::from_rows(vec![vec![(3, [1, 2], 0), (9, [4, 5], 0)], vec![]]);
 /// // a request keeping the keys below 2 (so dropping 3 and 9) reads the move of key 3
-/// assert_eq!(moves.offset(0, 2, None), Some([1, 2]));
-/// assert_eq!(moves.offset(0, 4, None), Some([4, 5]));
-/// assert_eq!(moves.offset(0, 10, None), None);
-/// assert_eq!(moves.offset(1, 0, None), None);
+/// assert_eq!(moves.shift(0, 2, None), Some([1, 2]));
+/// assert_eq!(moves.shift(0, 4, None), Some([4, 5]));
+/// assert_eq!(moves.shift(0, 10, None), None);
+/// assert_eq!(moves.shift(1, 0, None), None);
 /// // shared by a ring: key 9 is the orbit of codes 36..40; a request
 /// // keeping the codes below 38 drops the twins that are members 2 and 3
 /// // (faces 1 and 3 of the ring, the point's own face here)
-/// assert_eq!(moves.offset(0, 38, Some(2)), Some([4, 5]));
-/// assert_eq!(moves.offset(0, 38, Some(1)), None);
+/// assert_eq!(moves.shift(0, 38, Some(2)), Some([4, 5]));
+/// assert_eq!(moves.shift(0, 38, Some(1)), None);
 /// ```
 pub struct DropMoves {
     decoded: OnceLock<MoveRows>,
@@ -59,7 +61,8 @@ pub struct DropMoves {
 struct MoveRows {
     starts: Vec<u32>,
     keys: Vec<u16>,
-    offsets: Vec<[i8; 2]>,
+    /// Each move's shift from its row's bin offset.
+    shifts: Vec<[i8; 2]>,
     /// The dropped code's face in the ring less the point's, mod 4.
     turns: Vec<u8>,
 }
@@ -70,7 +73,7 @@ struct MoveRows {
 const MEMBER_OF_FACE: [u8; 4] = [0, 2, 1, 3];
 
 impl DropMoves {
-    /// Moves from each row's list of `(key, offset, turn)`, keys
+    /// Moves from each row's list of `(key, shift, turn)`, keys
     /// increasing; `turn` is the dropped code's face in its ring less the
     /// point's, mod 4 (0 where rows are per tile). A row holds at most
     /// [`MOST_MOVES_A_ROW`]: the builder keeps a row's highest keys, which
@@ -83,7 +86,7 @@ impl DropMoves {
         for row in rows {
             let kept = &row[row.len().saturating_sub(MOST_MOVES_A_ROW)..];
             decoded.keys.extend(kept.iter().map(|m| m.0));
-            decoded.offsets.extend(kept.iter().map(|m| m.1));
+            decoded.shifts.extend(kept.iter().map(|m| m.1));
             decoded.turns.extend(kept.iter().map(|m| m.2 & 3));
             decoded.starts.push(decoded.keys.len() as u32);
         }
@@ -108,8 +111,9 @@ impl DropMoves {
         self.len() == 0
     }
 
-    /// The offset of row `row` for a request that drops the keys from
-    /// `dropped_from` up: the move of its lowest such key, `None` if the
+    /// The shift of row `row` from its bin offset for a request that drops
+    /// the keys from `dropped_from` up: the move of its lowest such key,
+    /// `None` if the
     /// request drops none of the row's. Where rows are shared by a ring,
     /// `member` is the point's code's last two bits, a key is a ring orbit
     /// (its codes `4 * key .. 4 * key + 4`, counted from the lower bin's
@@ -117,7 +121,7 @@ impl DropMoves {
     /// within 16 bits), `dropped_from` counts codes from there, and a move
     /// counts where the request drops the orbit's twin beside the point.
     #[inline]
-    pub fn offset(&self, row: usize, dropped_from: u32, member: Option<u8>) -> Option<[i8; 2]> {
+    pub fn shift(&self, row: usize, dropped_from: u32, member: Option<u8>) -> Option<[i8; 2]> {
         let moves = self.get();
         let (start, end) = (moves.starts[row] as usize, moves.starts[row + 1] as usize);
         // a few moves a row: a scan beats a binary search
@@ -131,14 +135,14 @@ impl DropMoves {
                     .find(|&k| 4 * u32::from(moves.keys[k]) + u32::from(twin(k)) >= dropped_from)
             }
         };
-        found.map(|k| moves.offsets[k])
+        found.map(|k| moves.shifts[k])
     }
 
-    /// Every move, row by row: `(row, key, offset)`.
+    /// Every move, row by row: `(row, key, shift)`.
     pub fn iter(&self) -> impl Iterator<Item = (usize, u16, [i8; 2])> + '_ {
         let moves = self.get();
         (moves.starts.windows(2).enumerate()).flat_map(move |(row, w)| {
-            (w[0] as usize..w[1] as usize).map(move |k| (row, moves.keys[k], moves.offsets[k]))
+            (w[0] as usize..w[1] as usize).map(move |k| (row, moves.keys[k], moves.shifts[k]))
         })
     }
 
@@ -177,15 +181,16 @@ impl MoveRows {
     /// The raw layout: the row count (`u32`, little-endian), a count a
     /// row (`u8`), the keys (`u16`: the high bytes of all, then the low
     /// bytes, which zstd packs 3.5 % smaller than the keys' own bytes in
-    /// turn on levels 0-6 together), the offsets (`i8` pairs), then the
-    /// turns (`u8`).
+    /// turn on levels 0-6 together), the shifts (`i8` pairs: 3.3 % smaller
+    /// than the offsets the points take, format 11's), then the turns
+    /// (`u8`).
     fn to_raw(&self) -> Vec<u8> {
         let rows = self.starts.len().saturating_sub(1);
         let mut raw = (rows as u32).to_le_bytes().to_vec();
         raw.extend(self.starts.windows(2).map(|w| (w[1] - w[0]) as u8));
         raw.extend(self.keys.iter().map(|k| (k >> 8) as u8));
         raw.extend(self.keys.iter().map(|&k| k as u8));
-        raw.extend(self.offsets.iter().flat_map(|o| o.map(|v| v as u8)));
+        raw.extend(self.shifts.iter().flat_map(|o| o.map(|v| v as u8)));
         raw.extend(&self.turns);
         raw
     }
@@ -208,12 +213,12 @@ impl MoveRows {
         }
         let (high, rest) = rest.split_at(moves);
         let (low, rest) = rest.split_at(moves);
-        let (offsets, turns) = rest.split_at(2 * moves);
+        let (shifts, turns) = rest.split_at(2 * moves);
         let decoded = MoveRows {
             keys: (high.iter().zip(low))
                 .map(|(&h, &l)| u16::from_be_bytes([h, l]))
                 .collect(),
-            offsets: offsets
+            shifts: shifts
                 .chunks_exact(2)
                 .map(|o| [o[0] as i8, o[1] as i8])
                 .collect(),
@@ -308,14 +313,14 @@ mod tests {
             prop_assert_eq!(&packed, &moves);
             for (row, list) in lists.iter().enumerate() {
                 let expected = list.iter().find(|m| u32::from(m.0) >= from).map(|m| m.1);
-                prop_assert_eq!(packed.offset(row, from, None), expected);
+                prop_assert_eq!(packed.shift(row, from, None), expected);
                 // on a ring: the twin on the face `turn` quarter turns on
                 let face = |m: u8| [0u8, 2, 1, 3][m as usize];
                 let dropped = |m: &(u16, [i8; 2], u8)| {
                     4 * u32::from(m.0) + u32::from(face((face(member) + m.2) % 4)) >= from
                 };
                 let on_ring = list.iter().find(|m| dropped(m)).map(|m| m.1);
-                prop_assert_eq!(packed.offset(row, from, Some(member)), on_ring);
+                prop_assert_eq!(packed.shift(row, from, Some(member)), on_ring);
             }
         }
     }

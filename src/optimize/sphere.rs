@@ -75,6 +75,10 @@ pub struct BuildOptions {
     /// move points only where the fills leave a hole: level 6's moves for
     /// every drop took 2.15 MB, past the 4 MB budget.
     pub selective_moves_from: u8,
+    /// Per level with drop moves, how far about a hole the kept points
+    /// move and the shortest move stored ([`MoveReach`]); levels past the
+    /// list's end take its last entry.
+    pub move_reach: Vec<MoveReach>,
     /// First level whose neighbourhood classes are enumerated and relaxed,
     /// below `exact_levels`: each class level relaxes from the one above,
     /// so the class table starts warm (started cold, its classes crowded
@@ -157,7 +161,55 @@ pub struct BinCoupling {
     pub settle: usize,
 }
 
+/// How far a drop's moves reach on one level ([`BuildOptions::move_reach`]).
+///
+/// A wider reach closes more of a drop's hole and stores more moves.
+/// Level 4 at reach 2.0 and shortest 0.12 (scratch, refitted zonal warps,
+/// the sweep's 12 level-4 counts): energy between bins -1.0826 ->
+/// -1.0870 at N = 20,188 and -1.0845 -> -1.0867 at 51,507, for 54 kB
+/// more table. Level 5 would need about 200 kB more, past the 4 MB
+/// budget.
+///
+/// # Example
+/// ```
+/// use tessera::optimize::sphere::BuildOptions;
+/// let options = BuildOptions::default();
+/// assert!(options.move_reach.iter().all(|m| m.reach > 1.0 && m.shortest > 0.0));
+/// ```
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct MoveReach {
+    /// Kept points within this many spacings of a hole move when it opens.
+    pub reach: f64,
+    /// A move shorter than this many spacings is neither made nor stored,
+    /// which keeps the table small: level 5's moves took 811 kB at 0.05
+    /// and 640 kB at 0.10, and over 20 counts between its bins the
+    /// covering radius moved from 3.09 to 3.11 / sqrt(N) on average
+    /// (worst 3.32 and 3.27). Levels 0-4's took 120 kB less at 0.10 than
+    /// at 0.05, their sweep counts keeping separation >= 2.52 and
+    /// covering <= 3.08.
+    pub shortest: f64,
+}
+
+impl MoveReach {
+    /// Level 0-3's, 5's and 6's reach: 1.5 spacings, moves of 0.10 and up.
+    const NARROW: MoveReach = MoveReach {
+        reach: 1.5,
+        shortest: 0.10,
+    };
+    /// Level 4's: 2.0 spacings, moves of 0.12 and up.
+    const WIDE: MoveReach = MoveReach {
+        reach: 2.0,
+        shortest: 0.12,
+    };
+}
+
 impl BuildOptions {
+    /// The reach of `level`'s drop moves ([`BuildOptions::move_reach`]).
+    fn move_reach(&self, level: u32) -> MoveReach {
+        let last = self.move_reach.len().saturating_sub(1);
+        self.move_reach[(level as usize).min(last)]
+    }
+
     /// The grid step, in the table's 1/40 cells, of `level`'s offsets,
     /// fills and drop moves (see [`BuildOptions::deep_tile_step`]).
     fn grid_step(&self, level: u32) -> u8 {
@@ -179,6 +231,14 @@ impl Default for BuildOptions {
             fill_levels: 7,
             drop_move_levels: 7,
             selective_moves_from: 6,
+            move_reach: vec![
+                MoveReach::NARROW,
+                MoveReach::NARROW,
+                MoveReach::NARROW,
+                MoveReach::NARROW,
+                MoveReach::WIDE,
+                MoveReach::NARROW,
+            ],
             class_from: 4,
             class_depth: 6,
             class_radius: 2,
@@ -295,13 +355,17 @@ pub fn build(
         || options.class_separation_depth > 2
         || options.drop_move_levels > options.exact_levels
         || !drop_move_keys_fit(options)
+        || options.move_reach.is_empty()
+        || !(options.move_reach.iter())
+            .all(|m| m.reach > 0.0 && m.reach.is_finite() && m.shortest >= 0.0)
         || !(options.bin_coupling.strength >= 0.0 && options.bin_coupling.strength.is_finite())
     {
         return Err(Error::Request(format!(
             "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
              0 < fill_levels <= exact_levels, bins >= 6, deep_tile_step > 0, 0 < class_separation_depth <= 2, \
-             drop_move_levels <= exact_levels with 16-bit keys, a finite bin coupling >= 0)"
+             drop_move_levels <= exact_levels with 16-bit keys, a move reach > 0 per level, \
+             a finite bin coupling >= 0)"
         )));
     }
     let mut report = BuildReport::default();

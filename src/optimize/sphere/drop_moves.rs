@@ -15,7 +15,7 @@
 //! budget. It keeps its sibling fills, and a drop moves points only where
 //! it leaves a hole the fills do not close (see [`HOLE_WIDER`]).
 
-use super::{skew, to_local, within_room, BinSet, BuildOptions, Progress};
+use super::{skew, to_local, within_room, BinSet, BuildOptions, MoveReach, Progress};
 use crate::lut::{dequantise, move_key_base, DropMoves, SphereLut};
 use crate::polyomino::Shape;
 use crate::relax::relax_among_fixed;
@@ -26,8 +26,6 @@ use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Kept points within this many spacings of a hole move when it opens.
-const REACH: f64 = 1.5;
 /// Points dropped within this many spacings of a new hole are one hole
 /// with it.
 const HOLE: f64 = 2.0;
@@ -41,13 +39,6 @@ const ITERATIONS: usize = 5;
 const STOPPED: f64 = 0.1;
 /// Rounds of pinning a drop, at most.
 const PIN_ROUNDS: usize = 2;
-/// A move shorter than this many spacings is neither made nor stored,
-/// which keeps the table small: level 5's moves took 811 kB at 0.05 and
-/// 640 kB at 0.10, and over 20 counts between its bins the covering
-/// radius moved from 3.09 to 3.11 / sqrt(N) on average (worst 3.32 and
-/// 3.27). Levels 0-4's took 120 kB less at 0.10 than at 0.05, their
-/// sweep counts keeping separation >= 2.52 and covering <= 3.08.
-const SHORTEST: f64 = 0.10;
 /// On the levels that keep their sibling fills, a drop moves points only
 /// where, the fills in place, it leaves a hole wider than this over
 /// sqrt(N) (the widest Voronoi cell radius of the kept points about it).
@@ -98,7 +89,7 @@ pub(super) fn drop_moves(
             bins.par_extend((1..lut.bins()).into_par_iter().map(|bin| {
                 let step = options.grid_step(level);
                 let set = BinSet::new(tiling, lut, &by_code, bin);
-                BinDrops::new(set, step, fills).solve()
+                BinDrops::new(set, step, fills, options.move_reach(level)).solve()
             }));
             progress("drop moves", u64::from(level) + 1, u64::from(levels));
             bins
@@ -120,6 +111,8 @@ struct BinDrops<'a> {
     /// codes (equal but for the last two bits) drop together.
     ring: bool,
     step: u8,
+    /// How far about a hole points move, and the shortest move stored.
+    reach: MoveReach,
     /// The [`GUARD`] distance.
     guard: f64,
     /// Where a moved point may lie: the tile grown by three cells (and
@@ -142,9 +135,9 @@ struct BinDrops<'a> {
 }
 
 impl<'a> BinDrops<'a> {
-    /// The drops of `set`'s bin, its moves on a grid of `step`; with
-    /// `fills`, on top of the level's sibling fills.
-    fn new(set: BinSet<'a>, step: u8, fills: bool) -> Self {
+    /// The drops of `set`'s bin, its moves on a grid of `step` within
+    /// `reach`; with `fills`, on top of the level's sibling fills.
+    fn new(set: BinSet<'a>, step: u8, fills: bool, reach: MoveReach) -> Self {
         let lower = set.below();
         let BinSet {
             tiling,
@@ -169,6 +162,7 @@ impl<'a> BinDrops<'a> {
             ring: lut.rows(level) < by_code.len(),
             guard: GUARD * (4.0 * PI / lower.max(1) as f64).sqrt(),
             step,
+            reach,
             room: tiling.shape().dilated().dilated().dilated(),
             tree,
             current: sites.clone(),
@@ -181,7 +175,8 @@ impl<'a> BinDrops<'a> {
 
     /// Drops the codes from the top, a ring orbit at a time where rows
     /// are shared (keyed by its place among the orbits from the lower
-    /// count's), and returns the moves row by row.
+    /// count's), and returns the moves row by row, as shifts from the
+    /// bin's offsets.
     fn solve(mut self) -> DropMoves {
         let mut rows = vec![Vec::new(); self.lut.rows(self.level)];
         let mut top = self.sites.len();
@@ -201,8 +196,10 @@ impl<'a> BinDrops<'a> {
                 let key = (first - from) / if self.ring { 4 } else { 1 };
                 // `build` checks that every bin's keys fit
                 let key = u16::try_from(key).expect("a bin's keys fit 16 bits");
+                let bin_offsets = &self.lut.tables[self.level][self.bin];
                 for (row, offset, turn) in self.drop(first..top) {
-                    rows[row].push((key, offset, turn));
+                    let shift = [0, 1].map(|c| offset[c].wrapping_sub(bin_offsets[row][c]));
+                    rows[row].push((key, shift, turn));
                 }
             }
             top = first;
@@ -255,13 +252,16 @@ impl<'a> BinDrops<'a> {
         let start: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let movable: Vec<usize> = (0..around.len())
             .filter(|&k| !filled.contains(&around[k]))
-            .filter(|&k| hole.iter().any(|h| start[k].distance(*h) < REACH * spacing))
+            .filter(|&k| {
+                hole.iter()
+                    .any(|h| start[k].distance(*h) < self.reach.reach * spacing)
+            })
             .collect();
         if movable.is_empty() {
             return self.by_row(moves, codes);
         }
         let (movable, targets) = self.relax_within_room(&around, &start, movable, spacing);
-        let shortest = SHORTEST * spacing;
+        let shortest = self.reach.shortest * spacing;
         // the moves all the way, or a share of the way where a point the
         // room stopped short left another too close to it
         let relaxed = (SHARES.iter())
@@ -343,14 +343,14 @@ impl<'a> BinDrops<'a> {
     }
 
     /// The widest Voronoi cell radius of the points of `around` within
-    /// [`REACH`] spacings of `hole`, among the points of `around`.
+    /// the reach's spacings of `hole`, among the points of `around`.
     fn widest_hole(&self, around: &[usize], hole: &[DVec3], spacing: f64) -> f64 {
         let points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let mut normals = Vec::new();
         (0..points.len())
             .filter(|&k| {
                 hole.iter()
-                    .any(|h| points[k].distance(*h) < REACH * spacing)
+                    .any(|h| points[k].distance(*h) < self.reach.reach * spacing)
             })
             .map(|k| crate::voronoi::cell_of(&points, None, k, &mut normals, f64::INFINITY).radius)
             .fold(0.0, f64::max)
