@@ -205,7 +205,7 @@ impl MoveReach {
 
 impl BuildOptions {
     /// The reach of `level`'s drop moves ([`BuildOptions::move_reach`]).
-    fn move_reach(&self, level: u32) -> MoveReach {
+    fn reach_on(&self, level: u32) -> MoveReach {
         let last = self.move_reach.len().saturating_sub(1);
         self.move_reach[(level as usize).min(last)]
     }

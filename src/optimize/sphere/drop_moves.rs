@@ -89,7 +89,7 @@ pub(super) fn drop_moves(
             bins.par_extend((1..lut.bins()).into_par_iter().map(|bin| {
                 let step = options.grid_step(level);
                 let set = BinSet::new(tiling, lut, &by_code, bin);
-                BinDrops::new(set, step, fills, options.move_reach(level)).solve()
+                BinDrops::new(set, step, fills, options.reach_on(level)).solve()
             }));
             progress("drop moves", u64::from(level) + 1, u64::from(levels));
             bins
