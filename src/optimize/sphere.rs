@@ -76,8 +76,8 @@ pub struct BuildOptions {
     /// every drop took 2.15 MB, past the 4 MB budget.
     pub selective_moves_from: u8,
     /// Per level with drop moves, how far about a hole the kept points
-    /// move and the shortest move stored ([`MoveReach`]); levels past the
-    /// list's end take its last entry.
+    /// move and the shortest move stored ([`MoveReach`]), one entry a
+    /// level of `0..drop_move_levels`.
     pub move_reach: Vec<MoveReach>,
     /// First level whose neighbourhood classes are enumerated and relaxed,
     /// below `exact_levels`: each class level relaxes from the one above,
@@ -167,8 +167,10 @@ pub struct BinCoupling {
 /// Level 4 at reach 2.0 and shortest 0.12 (scratch, refitted zonal warps,
 /// the sweep's 12 level-4 counts): energy between bins -1.0826 ->
 /// -1.0870 at N = 20,188 and -1.0845 -> -1.0867 at 51,507, for 54 kB
-/// more table. Level 5 would need about 200 kB more, past the 4 MB
-/// budget.
+/// more table. Level 5 at reach 2.0 stores no move under 0.15 spacings,
+/// which the budget holds (scratch: N = 82,272 -1.0837 -> -1.0856, for
+/// 22 kB more; its covering 3.06 -> 3.26 / sqrt(N)); at 0.10 it would
+/// take about 200 kB more.
 ///
 /// # Example
 /// ```
@@ -191,7 +193,7 @@ pub struct MoveReach {
 }
 
 impl MoveReach {
-    /// Level 0-3's, 5's and 6's reach: 1.5 spacings, moves of 0.10 and up.
+    /// Levels 0-3's and 6's reach: 1.5 spacings, moves of 0.10 and up.
     const NARROW: MoveReach = MoveReach {
         reach: 1.5,
         shortest: 0.10,
@@ -201,13 +203,20 @@ impl MoveReach {
         reach: 2.0,
         shortest: 0.12,
     };
+    /// Level 5's: 2.0 spacings, moves of 0.15 and up, which the budget
+    /// holds (at 0.13 its moves took 114 kB more, at reach 1.75 and 0.12
+    /// 30 kB more, both past the 4 MB).
+    const WIDE_SPARSE: MoveReach = MoveReach {
+        reach: 2.0,
+        shortest: 0.15,
+    };
 }
 
 impl BuildOptions {
     /// The reach of `level`'s drop moves ([`BuildOptions::move_reach`]).
     fn reach_on(&self, level: u32) -> MoveReach {
-        let last = self.move_reach.len().saturating_sub(1);
-        self.move_reach[(level as usize).min(last)]
+        // `build` checks that every level with drop moves has an entry
+        self.move_reach[level as usize]
     }
 
     /// The grid step, in the table's 1/40 cells, of `level`'s offsets,
@@ -237,6 +246,7 @@ impl Default for BuildOptions {
                 MoveReach::NARROW,
                 MoveReach::NARROW,
                 MoveReach::WIDE,
+                MoveReach::WIDE_SPARSE,
                 MoveReach::NARROW,
             ],
             class_from: 4,
@@ -355,7 +365,7 @@ pub fn build(
         || options.class_separation_depth > 2
         || options.drop_move_levels > options.exact_levels
         || !drop_move_keys_fit(options)
-        || options.move_reach.is_empty()
+        || options.move_reach.len() != usize::from(options.drop_move_levels)
         || !(options.move_reach.iter())
             .all(|m| m.reach > 0.0 && m.reach.is_finite() && m.shortest >= 0.0)
         || !(options.bin_coupling.strength >= 0.0 && options.bin_coupling.strength.is_finite())
@@ -364,7 +374,7 @@ pub fn build(
             "inconsistent build options: {options:?} (need 0 < class_from <= exact_levels - 2, exact_levels <= \
              class_depth + 1 <= 11, class_from < class_depth, ring_from <= exact_levels, \
              0 < fill_levels <= exact_levels, bins >= 6, deep_tile_step > 0, 0 < class_separation_depth <= 2, \
-             drop_move_levels <= exact_levels with 16-bit keys, a move reach > 0 per level, \
+             drop_move_levels <= exact_levels with 16-bit keys, a move reach > 0 for each of them, \
              a finite bin coupling >= 0)"
         )));
     }
