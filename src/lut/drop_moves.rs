@@ -113,8 +113,7 @@ impl DropMoves {
 
     /// The shift of row `row` from its bin offset for a request that drops
     /// the keys from `dropped_from` up: the move of its lowest such key,
-    /// `None` if the
-    /// request drops none of the row's. Where rows are shared by a ring,
+    /// `None` if the request drops none of the row's. Where rows are shared by a ring,
     /// `member` is the point's code's last two bits, a key is a ring orbit
     /// (its codes `4 * key .. 4 * key + 4`, counted from the lower bin's
     /// count rounded down to a whole orbit, which keeps level 6's bins

@@ -213,12 +213,6 @@ impl MoveReach {
 }
 
 impl BuildOptions {
-    /// The reach of `level`'s drop moves ([`BuildOptions::move_reach`]).
-    fn reach_on(&self, level: u32) -> MoveReach {
-        // `build` checks that every level with drop moves has an entry
-        self.move_reach[level as usize]
-    }
-
     /// The grid step, in the table's 1/40 cells, of `level`'s offsets,
     /// fills and drop moves (see [`BuildOptions::deep_tile_step`]).
     fn grid_step(&self, level: u32) -> u8 {

@@ -89,7 +89,9 @@ pub(super) fn drop_moves(
             bins.par_extend((1..lut.bins()).into_par_iter().map(|bin| {
                 let step = options.grid_step(level);
                 let set = BinSet::new(tiling, lut, &by_code, bin);
-                BinDrops::new(set, step, fills, options.reach_on(level)).solve()
+                // `build` checks that every level with drop moves has an entry
+                let reach = options.move_reach[level as usize];
+                BinDrops::new(set, step, fills, reach).solve()
             }));
             progress("drop moves", u64::from(level) + 1, u64::from(levels));
             bins
