@@ -39,6 +39,7 @@ use tessera::baselines::median_cut::{median_cut, MedianCut};
 use tessera::baselines::{random_rotation, uniform_random_sphere};
 use tessera::density::envmap::EnvMap;
 use tessera::lights::{lights, lights_with_stats, Light, LightOptions, LloydWeight, RgbMap};
+use tessera::metrics::irradiance;
 use tessera::metrics::irradiance::relative_rmse;
 use tessera::synth::{Sky, SynthMap};
 
@@ -183,45 +184,17 @@ fn lobes(c: f64) -> [f64; 2] {
 }
 
 fn reference(map: &EnvMap, probes: &Probes) -> Reference {
-    let (w, h) = (map.width(), map.height());
     let (nn, na) = (probes.normals.len(), probes.axes.len());
-    let sums = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut s = vec![0.0; nn + 2 * na];
-            for i in 0..w {
-                let v = map.values()[j * w + i];
-                if v <= 0.0 {
-                    continue;
-                }
-                let mass = v * map.pixel_solid_angle(j);
-                let k = if mass > 1e-4 * map.integral() { 32 } else { 4 };
-                let weight = mass / (k * k) as f64;
-                for q in 0..k * k {
-                    let (u, t) = (
-                        ((q % k) as f64 + 0.5) / k as f64,
-                        ((q / k) as f64 + 0.5) / k as f64,
-                    );
-                    let d = map.direction_in_pixel(i, j, u, t);
-                    for (a, n) in probes.normals.iter().enumerate() {
-                        s[a] += weight * n.dot(d).max(0.0);
-                    }
-                    for (a, x) in probes.axes.iter().enumerate() {
-                        let [g10, g100] = lobes(x.dot(d));
-                        s[nn + a] += weight * g10;
-                        s[nn + na + a] += weight * g100;
-                    }
-                }
-            }
-            s
-        })
-        .reduce(
-            || vec![0.0; nn + 2 * na],
-            |mut a, b| {
-                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                a
-            },
-        );
+    let sums = irradiance::quadrature(map, nn + 2 * na, |d, weight, s| {
+        for (a, n) in probes.normals.iter().enumerate() {
+            s[a] += weight * n.dot(d).max(0.0);
+        }
+        for (a, x) in probes.axes.iter().enumerate() {
+            let [g10, g100] = lobes(x.dot(d));
+            s[nn + a] += weight * g10;
+            s[nn + na + a] += weight * g100;
+        }
+    });
     Reference {
         diffuse: sums[..nn].to_vec(),
         glossy: [sums[nn..nn + na].to_vec(), sums[nn + na..].to_vec()],

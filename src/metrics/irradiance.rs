@@ -45,12 +45,41 @@ pub fn exact(map: &EnvMap, normals: &[DVec3]) -> Vec<f64> {
 /// assert!((g[0] - std::f64::consts::TAU / 11.0).abs() < 1e-2);
 /// ```
 pub fn exact_lobe(map: &EnvMap, axes: &[DVec3], lobe: impl Fn(f64) -> f64 + Sync) -> Vec<f64> {
+    quadrature(map, axes.len(), |d, weight, sums| {
+        for (sum, n) in sums.iter_mut().zip(axes) {
+            *sum += weight * lobe(n.dot(d));
+        }
+    })
+}
+
+/// Runs [`exact`]'s quadrature for several integrands at once: `add(d,
+/// weight, sums)` adds each integrand's value at node `d`, times
+/// `weight` (radiance times solid angle), into its entry of `sums`
+/// (`len` of them). One pass over the map serves every integrand.
+///
+/// # Example
+/// ```
+/// # use tessera::{density::envmap::{EnvMap, Up}, io::image::Raster, metrics::irradiance::quadrature};
+/// let map = EnvMap::new(Raster { width: 8, height: 4, values: vec![1.0; 32], bad_pixels: 0 }, Up::Z).unwrap();
+/// // the map's integral and its irradiance facing up, in one pass
+/// let sums = quadrature(&map, 2, |d, w, s| {
+///     s[0] += w;
+///     s[1] += w * d.z.max(0.0);
+/// });
+/// assert!((sums[0] - 4.0 * std::f64::consts::PI).abs() < 1e-9);
+/// assert!((sums[1] - std::f64::consts::PI).abs() < 1e-3);
+/// ```
+pub fn quadrature(
+    map: &EnvMap,
+    len: usize,
+    add: impl Fn(DVec3, f64, &mut [f64]) + Sync,
+) -> Vec<f64> {
     let (w, h) = (map.width(), map.height());
-    // row by row: each row's sub-pixel nodes against every normal
+    // row by row: each row's sub-pixel nodes against every integrand
     (0..h)
         .into_par_iter()
         .map(|j| {
-            let mut sums = vec![0.0; axes.len()];
+            let mut sums = vec![0.0; len];
             for i in 0..w {
                 let v = map.values()[j * w + i];
                 if v <= 0.0 {
@@ -64,16 +93,13 @@ pub fn exact_lobe(map: &EnvMap, axes: &[DVec3], lobe: impl Fn(f64) -> f64 + Sync
                         ((s % k) as f64 + 0.5) / k as f64,
                         ((s / k) as f64 + 0.5) / k as f64,
                     );
-                    let d = map.direction_in_pixel(i, j, u, t);
-                    for (sum, n) in sums.iter_mut().zip(axes) {
-                        *sum += weight * lobe(n.dot(d));
-                    }
+                    add(map.direction_in_pixel(i, j, u, t), weight, &mut sums);
                 }
             }
             sums
         })
         .reduce(
-            || vec![0.0; axes.len()],
+            || vec![0.0; len],
             |mut a, b| {
                 a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
                 a
