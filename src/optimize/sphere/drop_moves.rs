@@ -181,6 +181,7 @@ impl<'a> BinDrops<'a> {
     /// bin's offsets.
     fn solve(mut self) -> DropMoves {
         let mut rows = vec![Vec::new(); self.lut.rows(self.level)];
+        let bin_offsets = &self.lut.tables[self.level][self.bin];
         let mut top = self.sites.len();
         while top > self.lower + 1 {
             // at the ring-shared levels the orbit dropped whole, its twins
@@ -198,7 +199,6 @@ impl<'a> BinDrops<'a> {
                 let key = (first - from) / if self.ring { 4 } else { 1 };
                 // `build` checks that every bin's keys fit
                 let key = u16::try_from(key).expect("a bin's keys fit 16 bits");
-                let bin_offsets = &self.lut.tables[self.level][self.bin];
                 for (row, offset, turn) in self.drop(first..top) {
                     let shift = [0, 1].map(|c| offset[c].wrapping_sub(bin_offsets[row][c]));
                     rows[row].push((key, shift, turn));
@@ -254,10 +254,7 @@ impl<'a> BinDrops<'a> {
         let start: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let movable: Vec<usize> = (0..around.len())
             .filter(|&k| !filled.contains(&around[k]))
-            .filter(|&k| {
-                hole.iter()
-                    .any(|h| start[k].distance(*h) < self.reach.reach * spacing)
-            })
+            .filter(|&k| self.in_reach(start[k], &hole, spacing))
             .collect();
         if movable.is_empty() {
             return self.by_row(moves, codes);
@@ -344,16 +341,19 @@ impl<'a> BinDrops<'a> {
         (moves, vacated)
     }
 
+    /// Whether `point` lies within the reach's spacings of a point of `hole`.
+    fn in_reach(&self, point: DVec3, hole: &[DVec3], spacing: f64) -> bool {
+        let reach = self.reach.reach * spacing;
+        hole.iter().any(|h| point.distance(*h) < reach)
+    }
+
     /// The widest Voronoi cell radius of the points of `around` within
     /// the reach's spacings of `hole`, among the points of `around`.
     fn widest_hole(&self, around: &[usize], hole: &[DVec3], spacing: f64) -> f64 {
         let points: Vec<DVec3> = around.iter().map(|&c| self.current[c]).collect();
         let mut normals = Vec::new();
         (0..points.len())
-            .filter(|&k| {
-                hole.iter()
-                    .any(|h| points[k].distance(*h) < self.reach.reach * spacing)
-            })
+            .filter(|&k| self.in_reach(points[k], hole, spacing))
             .map(|k| crate::voronoi::cell_of(&points, None, k, &mut normals, f64::INFINITY).radius)
             .fold(0.0, f64::max)
     }
