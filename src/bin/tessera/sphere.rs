@@ -63,10 +63,12 @@ pub(crate) struct SphereArgs {
     strict: bool,
     /// Run K density-weighted Lloyd iterations on the set (about 1.5 s an
     /// iteration for 10^6 points on two cores, 10-15 s for 10^7): spacing
-    /// approaches a
-    /// centroidal Voronoi tessellation's, but prefixes are no longer
-    /// progressive (every point moves) and the set no longer follows the
-    /// density exactly, so the pdf column is the target density's.
+    /// approaches a centroidal Voronoi tessellation's, but prefixes are no
+    /// longer progressive (every point moves) and the set no longer follows
+    /// the density exactly, so the pdf column is the target density's.
+    /// Worth it past 983,040 uniform points, where the polar caps crowd:
+    /// separation 1.44-2.03 / sqrt(N) at 10^6-10^7, and 2.70 at 10^6 after
+    /// 10 iterations (docs/SPHERE_SWEEP.md).
     #[arg(long, value_name = "K", default_value_t = 0)]
     relax: usize,
     /// Print the set's separation, covering radius and mesh ratio (and a
