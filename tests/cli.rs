@@ -710,6 +710,73 @@ fn plot_over_a_map_lines_up_with_the_map() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An image's stipple comes out upright: the image's first rows are the
+/// picture's top rows, over the rectangle the points were sampled on.
+#[test]
+fn plot_plane_draws_an_image_stipple_upright_over_its_domain() {
+    let dir = std::env::temp_dir().join(format!("tessera-stipple-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    // lit only in the top-left quarter: rows 0..10 of 20, columns 0..20 of 40
+    image::GrayImage::from_fn(40, 20, |x, y| {
+        image::Luma([if x < 20 && y < 10 { 255 } else { 0 }])
+    })
+    .save(path("quarter.png"))
+    .unwrap();
+    let density = format!("image:{}", path("quarter.png"));
+    stdout(&[
+        "plane",
+        "--system",
+        "ppentomino",
+        "--density",
+        &density,
+        "-n",
+        "400",
+        "--domain",
+        "-2,0,2,2",
+        "-o",
+        &path("p.txt"),
+    ]);
+    stdout(&[
+        "plot",
+        "plane",
+        &path("p.txt"),
+        "--domain",
+        "-2,0,2,2",
+        "--png",
+        &path("p.png"),
+        "--size",
+        "200",
+    ]);
+    let img = image::open(path("p.png")).unwrap().to_luma8();
+    assert_eq!(img.dimensions(), (200, 100));
+    let dark: Vec<(u32, u32)> = img
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p[0] == 0)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(dark.len() >= 400);
+    // the lit quarter is columns 0..100 and rows 0..50 (3x3 dots may reach
+    // one pixel beyond)
+    for (x, y) in dark {
+        assert!(x <= 100 && y <= 50, "dot at {x},{y}");
+    }
+    // the default unit square does not hold them: an error naming the file
+    let out = tessera(&["plot", "plane", &path("p.txt"), "--png", &path("q.png")]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("p.txt") && err.contains("outside the plotted domain 0,0,1,1"),
+        "{err}"
+    );
+    // nor are the plane measures, defined on the unit square, taken of them
+    let out = tessera(&["metrics", "plane", &path("p.txt")]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("outside the unit square"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `--table FILE` samples with a table read at run time: the table `lut
 /// build` writes with the shipped options gives the built-in points, a
 /// table built otherwise gives others, and a table of another system is

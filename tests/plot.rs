@@ -1,19 +1,58 @@
 //! Pictures: PNGs decode at the right size and points land in the right pixels.
 
 use glam::{DVec2, DVec3};
+use tessera::density::rectangle::Rectangle;
 use tessera::plot::{
     equirectangular, line_plot, log_image, orthographic, stipple, Axes, Labels, Marker, Series,
     PALETTE,
 };
 
 #[test]
-fn stipple_places_points_y_up() {
-    let img = stipple(&[DVec2::new(0.0, 0.0), DVec2::new(0.999, 0.999)], 50);
+fn stipple_places_points_y_down_as_images() {
+    let img = stipple(
+        &[DVec2::new(0.0, 0.0), DVec2::new(0.999, 0.999)],
+        Rectangle::UNIT,
+        50,
+    )
+    .unwrap();
     assert_eq!(img.dimensions(), (50, 50));
-    assert_eq!(img.get_pixel(0, 49)[0], 0);
-    assert_eq!(img.get_pixel(49, 0)[0], 0);
+    assert_eq!(img.get_pixel(0, 0)[0], 0);
+    assert_eq!(img.get_pixel(49, 49)[0], 0);
     // 1250 pixels per point: 3x3 dots, the rest white
     assert_eq!(img.pixels().filter(|p| p[0] == 0).count(), 2 * 4);
+}
+
+#[test]
+fn stipple_maps_its_domain_onto_the_image() {
+    let domain = Rectangle::new(-1.0, 2.0, 3.0, 4.0).unwrap();
+    let points = [
+        DVec2::new(-1.0, 2.0),
+        DVec2::new(2.0, 2.5),
+        DVec2::new(3.0, 4.0),
+    ];
+    let img = stipple(&points, domain, 400).unwrap();
+    assert_eq!(img.dimensions(), (400, 200));
+    for (col, row) in [(0, 0), (300, 50), (399, 199)] {
+        assert_eq!(img.get_pixel(col, row)[0], 0, "({col}, {row})");
+    }
+    // 3x3 dots, the two in the corners clipped to 2x2
+    assert_eq!(img.pixels().filter(|p| p[0] == 0).count(), 4 + 9 + 4);
+}
+
+#[test]
+fn stipple_refuses_points_outside_its_domain_and_huge_images() {
+    let outside = [DVec2::new(0.5, 0.5), DVec2::new(0.5, 1.25)];
+    let e = stipple(&outside, Rectangle::UNIT, 64)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("point 2 (0.5, 1.25) lies outside"), "{e}");
+    let nan = [DVec2::new(f64::NAN, 0.5)];
+    let e = stipple(&nan, Rectangle::UNIT, 64).unwrap_err().to_string();
+    assert!(e.contains("point 1 (NaN, 0.5) is not finite"), "{e}");
+    let tall = Rectangle::new(0.0, 0.0, 1.0, 1e6).unwrap();
+    let e = stipple(&[], tall, 64).unwrap_err().to_string();
+    assert!(e.contains("pixels high"), "{e}");
+    assert!(stipple(&[], Rectangle::UNIT, 0).is_err());
 }
 
 #[test]

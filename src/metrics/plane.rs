@@ -43,6 +43,23 @@ pub fn hex_spacing(n: usize) -> f64 {
     (2.0 / (3f64.sqrt() * n as f64)).sqrt()
 }
 
+/// Index of the first point that is not finite or lies outside the closed
+/// unit square, where every measure here is defined (a set sampled on a
+/// `--domain` rectangle is not measured by them).
+///
+/// ```
+/// use glam::DVec2;
+/// use tessera::metrics::plane::first_outside_unit_square;
+/// assert_eq!(first_outside_unit_square(&[DVec2::ZERO, DVec2::ONE]), None);
+/// assert_eq!(first_outside_unit_square(&[DVec2::ZERO, DVec2::new(1.5, 0.5)]), Some(1));
+/// assert_eq!(first_outside_unit_square(&[DVec2::NAN]), Some(0));
+/// ```
+pub fn first_outside_unit_square(points: &[DVec2]) -> Option<usize> {
+    points
+        .iter()
+        .position(|p| !(p.cmpge(DVec2::ZERO).all() && p.cmple(DVec2::ONE).all()))
+}
+
 /// The indices of `points` along a Morton (Z-order) curve over their
 /// bounding box (32 bits per axis): points near in the plane are mostly
 /// near in this order, so visiting them in it keeps a k-d tree's nodes in

@@ -1,4 +1,5 @@
-//! Pictures a user looks at before reading numbers: planar stipples, sphere
+//! Pictures a user looks at before reading numbers: planar stipples (y
+//! down, as in images), sphere
 //! views (equirectangular and orthographic, samples over their map),
 //! periodogram images and line plots (linear or log-log, several series
 //! with markers and a legend, ticks, a title and axis names in an 8x8
@@ -6,7 +7,8 @@
 //!
 //! ```
 //! use tessera::plot::{line_plot, stipple, Axes, Labels, Marker, Series};
-//! let img = stipple(&[glam::DVec2::new(0.5, 0.5)], 64);
+//! let square = tessera::density::rectangle::Rectangle::UNIT;
+//! let img = stipple(&[glam::DVec2::new(0.5, 0.5)], square, 64).unwrap();
 //! assert_eq!(img.dimensions(), (64, 64));
 //! let s = Series { points: vec![(1.0, 1.0), (10.0, 0.1)], color: [200, 0, 0], name: String::new(), marker: Marker::Square };
 //! let plot = line_plot(&[s], Axes { log_x: true, log_y: true }, &Labels::default(), 320, 240);
@@ -16,7 +18,9 @@
 pub mod svg;
 
 use crate::density::envmap::Up;
+use crate::density::rectangle::Rectangle;
 use crate::lights::RgbMap;
+use crate::Error;
 use glam::{DVec2, DVec3};
 use image::{GrayImage, Luma, Rgb, RgbImage};
 use std::f64::consts::{PI, TAU};
@@ -82,28 +86,76 @@ fn pixel(t: f64, len: u32) -> i64 {
     ((t * len as f64).floor() as i64).clamp(0, len as i64 - 1)
 }
 
-/// Black dots for points of `[0, 1)²` on a white `size x size` image, y up
-/// (point `(x, y)` lands in column `⌊x size⌋`, row `⌊(1 − y) size⌋`).
+/// Black dots for planar points on a white image `width` pixels wide and
+/// as tall as `domain`'s aspect makes it, y down as in images, so that the
+/// stipple of an image density comes out upright: `(x, y)` lands in column
+/// `⌊(x − x0) / (x1 − x0) · width⌋` and row `⌊(y − y0) / (y1 − y0) · height⌋`
+/// (the far edges in the last column and row). A point that is not finite
+/// or lies outside `domain` is an error naming it, not a dot piled on the
+/// border, as is an image over [`MAX_STIPPLE_SIDE`] pixels high.
 ///
 /// # Example
 /// ```
-/// let img = tessera::plot::stipple(&[glam::DVec2::new(0.1, 0.1)], 100);
-/// assert_eq!(img.get_pixel(10, 89)[0], 0);
+/// use tessera::density::rectangle::Rectangle;
+/// let img = tessera::plot::stipple(&[glam::DVec2::new(0.1, 0.1)], Rectangle::UNIT, 100).unwrap();
+/// assert_eq!(img.get_pixel(10, 10)[0], 0);
 /// assert_eq!(img.get_pixel(50, 50)[0], 255);
+/// let wide = Rectangle::new(0.0, 0.0, 2.0, 1.0).unwrap();
+/// assert_eq!(tessera::plot::stipple(&[], wide, 100).unwrap().dimensions(), (100, 50));
+/// let e = tessera::plot::stipple(&[glam::DVec2::new(1.5, 0.5)], Rectangle::UNIT, 100);
+/// assert!(e.unwrap_err().to_string().contains("point 1 (1.5, 0.5)"));
 /// ```
-pub fn stipple(points: &[DVec2], size: u32) -> GrayImage {
-    let (mut img, radius) = canvas(size, size, points.len());
-    for p in points.iter().filter(|p| p.is_finite()) {
+pub fn stipple(points: &[DVec2], domain: Rectangle, width: u32) -> Result<GrayImage, Error> {
+    let size = domain.hi - domain.lo;
+    let height = (f64::from(width) * size.y / size.x).round().max(1.0);
+    if width == 0 || height > f64::from(MAX_STIPPLE_SIDE) {
+        return Err(Error::Request(format!(
+            "a stipple of the domain {} x {} at {width} pixels wide would be {height} pixels high; \
+             the image takes 1 to {MAX_STIPPLE_SIDE} pixels a side",
+            size.x, size.y
+        )));
+    }
+    let height = height as u32;
+    let (mut img, radius) = canvas(width, height, points.len());
+    for (i, p) in points.iter().enumerate() {
+        // closed on both sides: a point on the far edge is in the domain
+        let inside = p.cmpge(domain.lo).all() && p.cmple(domain.hi).all();
+        if !inside {
+            let (lo, hi) = (domain.lo, domain.hi);
+            let why = if p.is_finite() {
+                format!(
+                    "lies outside the plotted domain {},{},{},{}",
+                    lo.x, lo.y, hi.x, hi.y
+                )
+            } else {
+                "is not finite".into()
+            };
+            return Err(Error::Request(format!(
+                "point {} ({}, {}) {why}",
+                i + 1,
+                p.x,
+                p.y
+            )));
+        }
+        let t = (*p - domain.lo) / size;
         dot(
             &mut img,
-            pixel(p.x, size),
-            pixel(1.0 - p.y, size),
+            pixel(t.x, width),
+            pixel(t.y, height),
             radius,
             BLACK,
         );
     }
-    img
+    Ok(img)
 }
+
+/// The tallest (or widest) stipple [`stipple`] draws, in pixels.
+///
+/// # Example
+/// ```
+/// assert!(tessera::plot::MAX_STIPPLE_SIDE >= 4096);
+/// ```
+pub const MAX_STIPPLE_SIDE: u32 = 32_768;
 
 /// Pixel `(column, row)` of direction `m` (map frame, +Z up) in a
 /// `width x height` lat-long image with the map convention of

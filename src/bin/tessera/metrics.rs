@@ -105,6 +105,17 @@ pub(crate) fn metrics(args: MetricsArgs) -> Result<(), Error> {
         }
         Domain::Plane => {
             let points = read_plane_points(&args.file)?;
+            if let Some(i) = plane::first_outside_unit_square(&points) {
+                return Err(Error::File {
+                    path: args.file.clone(),
+                    reason: format!(
+                        "point {} ({}, {}) lies outside the unit square, where the plane measures are defined",
+                        i + 1,
+                        points[i].x,
+                        points[i].y
+                    ),
+                });
+            }
             let report = Printed::new(&plane::measure(&points, &options(&args, &progress)?));
             let mut spectrum = Vec::new();
             if spectral {

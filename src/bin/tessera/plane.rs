@@ -39,7 +39,7 @@ pub(crate) struct PlaneArgs {
     format: String,
     /// Sample the rectangle `x0,y0,x1,y1` instead of the unit square (the
     /// density's unit square stretched over it).
-    #[arg(long)]
+    #[arg(long, value_name = "X0,Y0,X1,Y1", allow_hyphen_values = true)]
     domain: Option<String>,
 }
 

@@ -3,6 +3,7 @@
 use crate::common::*;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
+use tessera::density::rectangle::Rectangle;
 use tessera::Error;
 
 #[derive(Args)]
@@ -23,9 +24,19 @@ pub(crate) struct PlotArgs {
     /// Orthographic view direction `LON,LAT` in degrees.
     #[arg(long, default_value = "0,0", allow_hyphen_values = true)]
     toward: String,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 1024)]
+    /// Image width in pixels (a plane's height follows its --domain).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=32768))]
     size: u32,
+    /// Plane: the rectangle `x0,y0,x1,y1` to draw, as given to `tessera
+    /// plane --domain` (default the unit square). y points down, as in
+    /// images, so the stipple of an image density comes out upright; a
+    /// point outside the rectangle is an error.
+    #[arg(
+        long = "domain",
+        value_name = "X0,Y0,X1,Y1",
+        allow_hyphen_values = true
+    )]
+    rectangle: Option<String>,
     /// Sphere, equirect view: draw the points in red over this lat-long
     /// map (OpenEXR, Radiance .hdr or PNG), tone-mapped, in the map's own
     /// convention (column 0 at phi = atan2(y, x) = 0), as `tessera sphere
@@ -52,9 +63,23 @@ pub(crate) fn plot(args: PlotArgs) -> Result<(), Error> {
         (Domain::Sphere, View::Ortho) if args.over.is_some() => Err(Error::Request(
             "--over applies to --view equirect (the map's own projection)".into(),
         )),
+        (Domain::Sphere, _) if args.rectangle.is_some() => Err(Error::Request(
+            "--domain is a plane's rectangle; it does not apply to sphere".into(),
+        )),
         (Domain::Plane, _) => {
             let points = read_plane_points(&args.file)?;
-            save_png(&plot::stipple(&points, args.size), &args.png)
+            let domain = match &args.rectangle {
+                Some(spec) => Rectangle::parse(spec)?,
+                None => Rectangle::UNIT,
+            };
+            let img = plot::stipple(&points, domain, args.size).map_err(|e| match e {
+                Error::Request(reason) => Error::File {
+                    path: args.file.clone(),
+                    reason,
+                },
+                other => other,
+            })?;
+            save_png(&img, &args.png)
         }
         (Domain::Sphere, View::Equirect) => {
             let points = read_sphere_points(&args.file)?;
