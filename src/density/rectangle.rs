@@ -48,7 +48,11 @@ impl Rectangle {
     /// assert!(e.contains("finite"), "{e}");
     /// ```
     pub fn new(x0: f64, y0: f64, x1: f64, y1: f64) -> Result<Self, Error> {
-        let fail = |why: String| Err(Error::Request(format!("domain {x0},{y0},{x1},{y1}: {why}")));
+        let fail = |why: String| {
+            Err(Error::Request(format!(
+                "domain {x0:?},{y0:?},{x1:?},{y1:?}: {why}"
+            )))
+        };
         if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
             return fail("every corner coordinate must be finite".into());
         }
