@@ -88,7 +88,8 @@ impl System {
 pub(crate) enum Domain {
     /// Points on the unit sphere: any sphere format tessera writes (`x y z`, lonlat, csv, geojson, bin).
     Sphere,
-    /// Points `x y` in the unit square: any plane format tessera writes (xy, csv, bin).
+    /// Points `x y` in the unit square (`plot` draws another rectangle with
+    /// `--domain`): any plane format tessera writes (xy, csv, bin).
     Plane,
 }
 
