@@ -4,7 +4,7 @@ use glam::{DVec2, DVec3};
 use tessera::density::rectangle::Rectangle;
 use tessera::plot::{
     equirectangular, line_plot, log_image, orthographic, stipple, Axes, Labels, Marker, Series,
-    PALETTE,
+    MAX_STIPPLE_SIDE, PALETTE,
 };
 
 #[test]
@@ -53,6 +53,7 @@ fn stipple_refuses_points_outside_its_domain_and_huge_images() {
     let e = stipple(&[], tall, 64).unwrap_err().to_string();
     assert!(e.contains("pixels high"), "{e}");
     assert!(stipple(&[], Rectangle::UNIT, 0).is_err());
+    assert!(stipple(&[], Rectangle::UNIT, MAX_STIPPLE_SIDE + 1).is_err());
 }
 
 #[test]

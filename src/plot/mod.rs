@@ -92,7 +92,7 @@ fn pixel(t: f64, len: u32) -> i64 {
 /// `⌊(x − x0) / (x1 − x0) · width⌋` and row `⌊(y − y0) / (y1 − y0) · height⌋`
 /// (the far edges in the last column and row). A point that is not finite
 /// or lies outside `domain` is an error naming it, not a dot piled on the
-/// border, as is an image over [`MAX_STIPPLE_SIDE`] pixels high.
+/// border, as is an image with a side over [`MAX_STIPPLE_SIDE`] pixels.
 ///
 /// # Example
 /// ```
@@ -108,10 +108,10 @@ fn pixel(t: f64, len: u32) -> i64 {
 pub fn stipple(points: &[DVec2], domain: Rectangle, width: u32) -> Result<GrayImage, Error> {
     let size = domain.hi - domain.lo;
     let height = (f64::from(width) * size.y / size.x).round().max(1.0);
-    if width == 0 || height > f64::from(MAX_STIPPLE_SIDE) {
+    if width == 0 || width > MAX_STIPPLE_SIDE || height > f64::from(MAX_STIPPLE_SIDE) {
         return Err(Error::Request(format!(
             "a stipple of the domain {} x {} at {width} pixels wide would be {height} pixels high; \
-             the image takes 1 to {MAX_STIPPLE_SIDE} pixels a side",
+             an image takes 1 to {MAX_STIPPLE_SIDE} pixels a side",
             size.x, size.y
         )));
     }
