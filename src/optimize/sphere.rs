@@ -147,10 +147,12 @@ pub struct BuildOptions {
 /// ```
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct BinCoupling {
-    /// Levels `0..levels` are coupled. Level 6's coupled offsets took
-    /// 148 kB more than its uncoupled ones (zstd: its rows, started from
-    /// their classes' offsets, move further from them), past the 4 MB
-    /// budget.
+    /// Levels `0..levels` are coupled. On the deepest per-tile level
+    /// (`exact_levels - 1`, 6) the full bin is held: coupled too, it
+    /// took 47 kB more (zstd: its rows, started from their classes'
+    /// offsets, leave them), past the 4 MB budget. Coupling the other
+    /// eleven took 16 kB net: offsets 110 kB and fills 17 kB more, and
+    /// 112 kB less of drop moves, as the coupled bins leave fewer holes.
     pub levels: u8,
     /// Coupled rounds: a Lloyd step per bin, then each row's offset in a
     /// bin averaged with its offsets in the two bins beside it.
@@ -251,7 +253,7 @@ impl Default for BuildOptions {
             deep_tile_iterations: 8,
             deep_tile_step: 4,
             bin_coupling: BinCoupling {
-                levels: 6,
+                levels: 7,
                 rounds: 8,
                 strength: 1.0,
                 settle: 1,
@@ -1240,12 +1242,15 @@ fn relax(
         report.lloyd_residual.push(residual);
         let seams_before = seam_percentile(tiling, lut, (&tiles, &rows), &table);
         if level < u32::from(options.bin_coupling.levels) {
+            // the deepest per-tile level's full bin is held (see BinCoupling)
+            let held = (level + 1 == u32::from(options.exact_levels)).then_some(bins - 1);
             couple_bins(
                 tiling,
                 lut,
                 (&tiles, &rows),
                 &mut table,
                 (options.bin_coupling, &quadrature),
+                held,
             );
         }
         drop(quadrature);
@@ -1431,13 +1436,15 @@ const OVER_RELAXATION: f64 = 1.6;
 /// the uncoupled build's tables (`seam_percentile`, after the separation
 /// steps): the seams' 1st percentile went 1.24-2.42 -> 1.90-2.66 /
 /// sqrt(N) on levels 0-5 ([`BinCoupling`] for what the bins' own sets
-/// kept).
+/// kept). The `held` bin keeps its offsets (the bins beside it still
+/// average toward them).
 fn couple_bins(
     tiling: &SphereTiling,
     lut: &SphereLut,
     (tiles, rows): (&[SphereTile], &[u32]),
     table: &mut [[f64; 2]],
     (coupling, quadrature): (BinCoupling, &Quadrature),
+    held: Option<usize>,
 ) {
     let bins = lut.bins();
     let row_count = table.len() / bins;
@@ -1455,6 +1462,9 @@ fn couple_bins(
         let before = table.to_vec();
         for row in 0..row_count {
             for bin in 0..bins {
+                if held == Some(bin) {
+                    continue;
+                }
                 let Some(mut sum) = stepped[bin][row] else {
                     continue; // not in the bin's set: stays
                 };
@@ -2638,6 +2648,7 @@ mod tests {
             (&tiles, &rows),
             &mut table,
             (BuildOptions::default().bin_coupling, &quadrature),
+            None,
         );
         let coupled = seam_percentile(&tiling, lut, (&tiles, &rows), &table);
         assert!(coupled > seams + 0.4, "seams {seams:.3} -> {coupled:.3}");
