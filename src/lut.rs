@@ -573,8 +573,10 @@ impl SphereLut {
     /// one before it: a bin of a tree-indexed level but the last, from
     /// the bin below, but every [`DIFFERENCE_RUN`]th. Neighbouring bins'
     /// offsets are close (coupled, see
-    /// [`crate::optimize::sphere::BinCoupling`]); level 6's, uncoupled,
-    /// grew.
+    /// [`crate::optimize::sphere::BinCoupling`]). Level 6's bins are
+    /// stored whole: as differences (all twelve coupled, scratch) they
+    /// packed 36 kB larger, its rows that keep their classes' offsets
+    /// matching as they are.
     fn chained(&self) -> Vec<bool> {
         let tables = self.tables.iter().enumerate().flat_map(|(level, bins)| {
             let chained = level + 1 < self.exact_levels as usize;
