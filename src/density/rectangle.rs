@@ -88,6 +88,21 @@ impl Rectangle {
         }
     }
 
+    /// Whether `p` lies in the closed rectangle `[x0, x1] x [y0, y1]` (a
+    /// NaN coordinate does not): the bounds that pictures and measures of
+    /// a point file accept.
+    ///
+    /// # Example
+    /// ```
+    /// use glam::DVec2;
+    /// use tessera::density::rectangle::Rectangle;
+    /// assert!(Rectangle::UNIT.holds(DVec2::ONE));
+    /// assert!(!Rectangle::UNIT.holds(DVec2::new(0.5, f64::NAN)));
+    /// ```
+    pub fn holds(&self, p: DVec2) -> bool {
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all()
+    }
+
     /// Side of the covering square, `max(w, h)`.
     ///
     /// # Example

@@ -22,6 +22,7 @@
 
 use super::report::{quiet, Measure, Options, Progress, Report, Tally};
 use super::Dd;
+use crate::density::rectangle::Rectangle;
 use glam::DVec2;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -55,9 +56,7 @@ pub fn hex_spacing(n: usize) -> f64 {
 /// assert_eq!(first_outside_unit_square(&[DVec2::NAN]), Some(0));
 /// ```
 pub fn first_outside_unit_square(points: &[DVec2]) -> Option<usize> {
-    points
-        .iter()
-        .position(|p| !(p.cmpge(DVec2::ZERO).all() && p.cmple(DVec2::ONE).all()))
+    points.iter().position(|&p| !Rectangle::UNIT.holds(p))
 }
 
 /// The indices of `points` along a Morton (Z-order) curve over their

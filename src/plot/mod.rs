@@ -118,9 +118,7 @@ pub fn stipple(points: &[DVec2], domain: Rectangle, width: u32) -> Result<GrayIm
     let height = height as u32;
     let (mut img, radius) = canvas(width, height, points.len());
     for (i, p) in points.iter().enumerate() {
-        // closed on both sides: a point on the far edge is in the domain
-        let inside = p.cmpge(domain.lo).all() && p.cmple(domain.hi).all();
-        if !inside {
+        if !domain.holds(*p) {
             let (lo, hi) = (domain.lo, domain.hi);
             let why = if p.is_finite() {
                 format!(

@@ -25,7 +25,7 @@ pub(crate) struct PlotArgs {
     #[arg(long, default_value = "0,0", allow_hyphen_values = true)]
     toward: String,
     /// Image width in pixels (a plane's height follows its --domain).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=32768))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=i64::from(tessera::plot::MAX_STIPPLE_SIDE)))]
     size: u32,
     /// Plane: the rectangle `x0,y0,x1,y1` to draw, as given to `tessera
     /// plane --domain` (default the unit square). y points down, as in
