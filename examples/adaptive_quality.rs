@@ -1,7 +1,7 @@
 //! Issue 18's adaptive-quality measure: whether sets following a density
 //! keep the uniform set's spacing away from the density's edges. For caps
-//! of contrast 16 and 100, a lon/lat polygon of contrast 16 and generated
-//! environment maps, at each count, it takes every density level
+//! of contrast 16 and 100, a lon/lat polygon of contrast 16, a smooth bump
+//! of contrast 64 and generated environment maps, at each count, it takes every density level
 //! and, of the level's points lying more than two local spacings from any
 //! edge, the nearest-neighbour angle (to any point) times
 //! `√(4π N pdf(x))`; its 1st percentile is compared with the same measure
@@ -28,6 +28,7 @@ use std::time::Instant;
 use tessera::baselines::spherical_fibonacci;
 use tessera::density::envmap::{EnvMap, Up};
 use tessera::density::region::Regions;
+use tessera::density::sphere::SphereFn;
 use tessera::density::Density;
 use tessera::healpix::lonlat_to_vec;
 use tessera::metrics::sphere::{geodesic_distance, nearest_angles};
@@ -46,6 +47,10 @@ const SAMPLES_PER_SPACING: f64 = 8.0;
 
 /// The cap of the two cap cases: centre (lon, lat) and radius, degrees.
 const CAP: [f64; 3] = [20.0, 40.0, 25.0];
+
+/// The smooth bump's width (degrees): its density is `1 + (C - 1)
+/// exp(-(θ / BUMP_WIDTH)²)`, `θ` the angle from the cap's centre.
+const BUMP_WIDTH: f64 = 15.0;
 
 /// The polygon case's vertices (lon, lat in degrees; edges straight in the
 /// lon/lat plane, as `Regions` reads them).
@@ -181,6 +186,42 @@ fn polygon_case(contrast: f64) -> Case {
     )
 }
 
+/// A smooth bump of `contrast` about the cap's centre, as a geophysicist's
+/// regional refinement: its levels are octaves and it has no edges, so
+/// every point is measured, the bins changing from tile to tile. With
+/// `relative`, its `SphereFn` also has a relative Lipschitz constant.
+fn bump_case(contrast: f64, relative: bool) -> Case {
+    let [lon, lat, _] = CAP;
+    let centre = lonlat_to_vec(lon, lat);
+    let width = BUMP_WIDTH.to_radians();
+    let profile = move |theta: f64| 1.0 + (contrast - 1.0) * (-(theta / width).powi(2)).exp();
+    let bump = move |v: DVec3| profile(geodesic_distance(centre, v));
+    // |d/dθ| of (C - 1) exp(-(θ/w)²) peaks at θ = w / √2: (C - 1) √2 e^(-1/2) / w
+    let lipschitz = (contrast - 1.0) * 2f64.sqrt() * (-0.5f64).exp() / width;
+    let mut density = SphereFn::new(bump, lipschitz).expect("a positive density");
+    let mut name = format!("bump contrast {contrast}");
+    if relative {
+        // |d ln f / dθ| = (2θ/w²) (f - 1) / f, its largest value on a fine
+        // grid of θ (a smooth profile), with a margin
+        let k = (1..=100_000)
+            .map(|i| {
+                let theta = 5.0 * width * i as f64 / 100_000.0;
+                let f = profile(theta);
+                2.0 * theta / width.powi(2) * (f - 1.0) / f
+            })
+            .fold(0.0, f64::max)
+            * 1.001;
+        density = density.with_relative_lipschitz(k).expect("k >= 0");
+        name = format!("{name}, relative {k:.1}");
+    }
+    Case {
+        name,
+        density: Box::new(density),
+        edges: Vec::new(),
+        octaves: true,
+    }
+}
+
 /// A generated sky, Z up; its edges are the pixel sides between pixels of
 /// different octaves (a zero pixel is an octave of its own).
 fn map_case(sky: Sky) -> Case {
@@ -305,7 +346,8 @@ fn measure(case: &Case, n: usize, relax: usize) -> (Vec<Level>, usize) {
     tessera::relax::relax(&mut points, &*case.density, relax).expect("unit vectors");
     let angles = nearest_angles(&points);
     let boundary = case.boundary(n);
-    let edge_tree = tree(&boundary);
+    // (a smooth density has no edges)
+    let edge_tree = (!boundary.is_empty()).then(|| tree(&boundary));
     // per level: every value, and the inner points with their values
     type Bins = (Vec<f64>, Vec<DVec3>, Vec<f64>);
     let mut by_level: BTreeMap<i32, Bins> = BTreeMap::new();
@@ -317,8 +359,10 @@ fn measure(case: &Case, n: usize, relax: usize) -> (Vec<Level>, usize) {
         };
         let relative = sampler.pdf(*p) * 4.0 * PI;
         let value = angle * (n as f64 * relative).sqrt();
-        let nearest = edge_tree.nearest_one::<SquaredEuclidean>(&p.to_array());
-        let to_edge = geodesic_distance(*p, boundary[nearest.item as usize]);
+        let to_edge = edge_tree.as_ref().map_or(f64::INFINITY, |edges| {
+            let nearest = edges.nearest_one::<SquaredEuclidean>(&p.to_array());
+            geodesic_distance(*p, boundary[nearest.item as usize])
+        });
         let (all, inner, values) = by_level.entry(level).or_default();
         all.push(value);
         if to_edge > MARGIN * spacing(n, relative) {
@@ -367,6 +411,7 @@ fn main() {
     }
     let start = Instant::now();
     let mut cases = vec![cap_case(16.0), cap_case(100.0), polygon_case(16.0)];
+    cases.extend([bump_case(64.0, false), bump_case(64.0, true)]);
     cases.extend(skies.iter().map(|&sky| map_case(sky)));
     let mut runs = Vec::new();
     for &n in &counts {
@@ -483,20 +528,25 @@ fn report(
          - **Sets**: `Sampler::sphere().density(D).count(N)`, in the world frame (no seed). \
          **cap contrast C**: `cap:{lon},{lat},{radius},C` (`Regions`), C times denser inside. \
          **polygon contrast 16**: `polygon:{};16`, edges straight in the lon/lat plane. \
+         **bump contrast 64**: `1 + 63 exp(-(θ/{BUMP_WIDTH}°)²)`, `θ` the angle from the cap's \
+         centre, a smooth regional refinement, as a `SphereFn` with its Lipschitz constant \
+         (tile bounds `f(centre) + L r`) and with a relative one too (`|∇f| / f <= k`, \
+         `SphereFn::with_relative_lipschitz`: bounds `f(centre) e^(k r)`). \
          **map**: the generated skies {} (`synth::Sky`; `--maps`) at {width}x{height}, seed \
          {seed}, as luminance (`SynthMap::raster`, `EnvMap::new`, Z up).{}\n\
          - **pdf**: the density the samples follow, per steradian, integrating to 1 over the \
          sphere (`Sampler::pdf`); a uniform set has `pdf = 1/(4π)`. The local spacing is \
          `1/√(N pdf(x))` radians, the normalisation of `metrics::sphere::local_spacing`.\n\
-         - **Levels**: a region density's contrast (1 outside, C inside); for a map, the octave \
-         of the pixel's `pdf · 4π` (the pixels with `2^k <= pdf · 4π < 2^(k+1)` form a level), \
-         zero pixels being a level without points.\n\
+         - **Levels**: a region density's contrast (1 outside, C inside); for a map and the \
+         bump, the octave of `pdf · 4π` (the pixels or points with `2^k <= pdf · 4π < 2^(k+1)` \
+         form a level), zero pixels being a level without points.\n\
          - **Edges**: the rim of the cap, the polygon's sides, and for a map every pixel side \
          between pixels of different levels (steps of less than an octave inside a level are \
-         not edges). The distance from a point to the edges is its angle to the nearest of \
-         points placed along every edge at most 1/{SAMPLES_PER_SPACING} of the local spacing of \
-         the edge's denser side apart, so it reads at most 1/{} of a spacing long. A point is \
-         measured when that distance exceeds {MARGIN} of its own local spacings.\n\
+         not edges); the bump has none, every point of it is measured. The distance from a \
+         point to the edges is its angle to the nearest of points placed along every edge at \
+         most 1/{SAMPLES_PER_SPACING} of the local spacing of the edge's denser side apart, so \
+         it reads at most 1/{} of a spacing long. A point is measured when that distance \
+         exceeds {MARGIN} of its own local spacings.\n\
          - **Measure**: each point's geodesic angle to its nearest other point (of the whole \
          set, any level), times `√(4π N pdf(x))` (`√N` for a uniform set); 1st percentile \
          and median by nearest rank. **Reference**: the same over tessera's uniform set of the \

@@ -6,7 +6,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use std::collections::HashSet;
 use std::f64::consts::PI;
-use tessera::density::sphere::{angle_between, Cap};
+use tessera::density::sphere::{angle_between, Cap, SphereFn};
 use tessera::density::Uniform;
 use tessera::engine::Order;
 use tessera::healpix::FacePoint;
@@ -540,6 +540,46 @@ fn wider_drop_moves_meet_issue_18s_energy_floor_between_bins() {
 fn counts_are_exact_for_awkward_n() {
     for n in [0usize, 1, 2, 3, 239, 241, 1001, 4097] {
         assert_eq!(Sampler::sphere().count(n).generate().unwrap().len(), n);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    /// A von Mises-Fisher lobe's bounds hold over every point of a tile
+    /// (`|grad f| <= kappa` and `|grad f| / f <= kappa`), the relative one
+    /// never looser than the additive one.
+    #[test]
+    fn relative_lipschitz_bounds_hold_over_their_tiles(
+        kappa in 0.0f64..200.0,
+        axis in (-1.0f64..1.0, 0.0f64..std::f64::consts::TAU),
+        level in 0u32..6,
+        pick in 0usize..usize::MAX,
+    ) {
+        use tessera::density::Density;
+        let (z, phi) = axis;
+        let r = (1.0 - z * z).sqrt();
+        let mu = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+        let lobe = move |v: DVec3| (kappa * (v.dot(mu) - 1.0)).exp();
+        // |grad f| = kappa sin(angle) f <= kappa
+        let plain = SphereFn::new(lobe, kappa).unwrap();
+        let relative = SphereFn::new(lobe, kappa)
+            .unwrap()
+            .with_relative_lipschitz(kappa)
+            .unwrap();
+        let tiling = SphereTiling::default();
+        let tile = tiling
+            .tile_with_code(level, (pick % (240 << (2 * level))) as u128)
+            .unwrap();
+        let region = tiling.region(&tile);
+        let (bound, additive) = (relative.bound(&region), plain.bound(&region));
+        prop_assert!(bound <= additive);
+        for &(cx, cy) in tiling.shape().cells() {
+            for (a, b) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
+                let p = tiling.face_point(&tile, [cx as f64 + a, cy as f64 + b]).to_vec();
+                prop_assert!(lobe(p) <= bound * (1.0 + 1e-12), "f {} > bound {}", lobe(p), bound);
+                prop_assert!(lobe(p) <= additive * (1.0 + 1e-12));
+            }
+        }
     }
 }
 

@@ -191,8 +191,11 @@ impl Density<SphereRegion> for Cap {
 }
 
 /// A density given by a closure of the direction, with a Lipschitz constant
-/// (per radian) that makes its tile bounds conservative:
-/// `bound = f(centre) + lipschitz * radius`.
+/// (per radian) that makes its tile bounds conservative: the largest value
+/// at the tile's five cell centres plus `lipschitz` times the distance
+/// every point lies within of one ([`SphereRegion::cell_reach`]; a bare cap:
+/// `f(centre) + lipschitz * radius`), and optionally a relative one
+/// ([`SphereFn::with_relative_lipschitz`]).
 ///
 /// # Example
 /// ```
@@ -205,6 +208,8 @@ impl Density<SphereRegion> for Cap {
 pub struct SphereFn<F> {
     f: F,
     lipschitz: f64,
+    /// A bound on `|grad f| / f` (per radian), if given.
+    relative_lipschitz: Option<f64>,
     mean: f64,
 }
 
@@ -232,7 +237,12 @@ impl<F: Fn(DVec3) -> f64 + Sync> SphereFn<F> {
                 format!("its mean over the sphere is {mean}; it must be positive and finite"),
             ));
         }
-        Ok(SphereFn { f, lipschitz, mean })
+        Ok(SphereFn {
+            f,
+            lipschitz,
+            relative_lipschitz: None,
+            mean,
+        })
     }
 
     /// Replaces the estimated mean (integral / 4 pi) by an exact value.
@@ -248,6 +258,48 @@ impl<F: Fn(DVec3) -> f64 + Sync> SphereFn<F> {
         self.mean = mean;
         self
     }
+
+    /// Adds `k`, a bound on `|grad f| / f` (per radian; `|grad ln f|`
+    /// where `f > 0`): a tile's bound becomes the smaller of
+    /// `f + lipschitz * d` and `f * exp(k * d)`, `f` the largest value at
+    /// the tile's cell centres and `d` the distance every point lies within
+    /// of one (see [`SphereFn`]; where a cell centre has `f = 0`, the first
+    /// alone). Where a density spans a wide range, its Lipschitz constant
+    /// is set by the steep bright part, and over the dim parts it
+    /// overstates the density many times; the engine then places samples
+    /// for the bound and thins them to the density, which costs their
+    /// spacing (docs/SPHERE_ADAPTIVE.md, the bump). A von Mises-Fisher
+    /// lobe `exp(kappa (v . mu - 1))` has `k = kappa`.
+    ///
+    /// Errors: `k` negative or not finite.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{sphere::SphereFn, Density};
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let kappa = 20.0;
+    /// let lobe = |v: glam::DVec3| (kappa * (v.z - 1.0)).exp();
+    /// let plain = SphereFn::new(lobe, kappa).unwrap();
+    /// let relative = SphereFn::new(lobe, kappa).unwrap().with_relative_lipschitz(kappa).unwrap();
+    /// // a root tile on the equator, where the lobe is about e^-20
+    /// let sphere = SphereTiling::default();
+    /// let tile = sphere.roots().into_iter()
+    ///     .map(|root| sphere.region(&root))
+    ///     .find(|region| region.center().z.abs() < 0.1)
+    ///     .unwrap();
+    /// assert!(relative.bound(&tile) < 1e-4 && plain.bound(&tile) > 1.0);
+    /// assert!(SphereFn::new(lobe, kappa).unwrap().with_relative_lipschitz(-1.0).is_err());
+    /// ```
+    pub fn with_relative_lipschitz(mut self, k: f64) -> Result<Self, Error> {
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(Error::Density(
+                "closure".into(),
+                format!("relative Lipschitz constant {k} must be finite and >= 0"),
+            ));
+        }
+        self.relative_lipschitz = Some(k);
+        Ok(self)
+    }
 }
 
 /// Negative and non-finite importance counts as zero.
@@ -261,7 +313,29 @@ fn clean(v: f64) -> f64 {
 
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        clean((self.f)(region.center())) + self.lipschitz * region.radius
+        // every point of a tile lies within `cell_reach` of one of its five
+        // cell centres, a third of the way the cap's centre reaches: from
+        // their largest value the bound grows three times less (a bare cap
+        // is known only by its centre)
+        let reach = region.cell_reach();
+        let (value, least, distance) = if reach < region.radius {
+            let values = region.probes().map(|p| clean((self.f)(p)));
+            let most = values.iter().copied().fold(0.0, f64::max);
+            (
+                most,
+                values.iter().copied().fold(f64::INFINITY, f64::min),
+                reach,
+            )
+        } else {
+            let centre = clean((self.f)(region.center()));
+            (centre, centre, region.radius)
+        };
+        let additive = value + self.lipschitz * distance;
+        match self.relative_lipschitz {
+            // f <= f(p) e^(k d) at distance d from p, where no probe is 0
+            Some(k) if least > 0.0 => additive.min(value * (k * distance).exp()),
+            _ => additive,
+        }
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let probes = region.probes();

@@ -116,6 +116,23 @@ impl SphereRegion {
             .map(|[x, y]| FacePoint::new(self.face, x, y).to_vec())
     }
 
+    /// How far (rad) a point of the tile can lie from the nearest of its
+    /// five cell centres ([`SphereRegion::probes`]): half a cell's
+    /// diagonal, stretched by at most [`FACE_LIPSCHITZ`] onto the sphere,
+    /// about a third of the cap's radius. Infinite for a bare cap (see
+    /// [`SphereRegion::cell_side`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let region = sphere.region(&sphere.roots()[0]);
+    /// assert!(region.cell_reach() < 0.4 * region.radius);
+    /// ```
+    pub fn cell_reach(&self) -> f64 {
+        FACE_LIPSCHITZ * std::f64::consts::FRAC_1_SQRT_2 * self.cell_side()
+    }
+
     /// Side of the tile's cells in face coordinates: the smallest step
     /// between two (edge-adjacent) cell centres. Infinite for a bare cap
     /// whose cells all sit at its centre (as [`crate::density::sphere::Rotated`]
