@@ -1,8 +1,8 @@
 //! Issue 18's adaptive-quality measure: whether sets following a density
 //! keep the uniform set's spacing away from the density's edges. For caps
 //! of contrast 16 and 100, a lon/lat polygon of contrast 16, a smooth bump
-//! of contrast 64 and generated environment maps, at each count, it takes every density level
-//! and, of the level's points lying more than two local spacings from any
+//! of contrast 64 and generated environment maps, at each count, it takes
+//! every density level and, of the level's points lying more than two local spacings from any
 //! edge, the nearest-neighbour angle (to any point) times
 //! `√(4π N pdf(x))`; its 1st percentile is compared with the same measure
 //! on the uniform tessera set of the same count (floor: 0.85 times it).
@@ -530,8 +530,9 @@ fn report(
          **polygon contrast 16**: `polygon:{};16`, edges straight in the lon/lat plane. \
          **bump contrast 64**: `1 + 63 exp(-(θ/{BUMP_WIDTH}°)²)`, `θ` the angle from the cap's \
          centre, a smooth regional refinement, as a `SphereFn` with its Lipschitz constant \
-         (tile bounds `f(centre) + L r`) and with a relative one too (`|∇f| / f <= k`, \
-         `SphereFn::with_relative_lipschitz`: bounds `f(centre) e^(k r)`). \
+         (tile bounds `f + L d`, `f` the largest value at the tile's cell centres and `d` \
+         `SphereRegion::cell_reach`) and with a relative one too (`|∇f| / f <= k`, \
+         `SphereFn::with_relative_lipschitz`: also `f e^(k d)`). \
          **map**: the generated skies {} (`synth::Sky`; `--maps`) at {width}x{height}, seed \
          {seed}, as luminance (`SynthMap::raster`, `EnvMap::new`, Z up).{}\n\
          - **pdf**: the density the samples follow, per steradian, integrating to 1 over the \
