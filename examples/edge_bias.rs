@@ -54,9 +54,9 @@ impl Profile {
     }
 }
 
-/// Runs of `count` non-exact samples of a `cap` (radius `radius` degrees,
-/// contrast `contrast`), rotated by each seed, binned by their angle from
-/// its centre in `rings` of `width` degrees from `from`.
+/// `runs` runs of `count` non-exact samples of a cap of `radius` degrees
+/// and `contrast`, rotated by each seed, binned by their angle from its
+/// centre in 40 rings half a degree wide from 10 degrees inside its rim.
 fn sphere_profile(radius: f64, contrast: f64, count: usize, runs: u64) -> Profile {
     let tiling = SphereTiling::default();
     let cap = Cap::new(10.0, 20.0, radius, contrast).unwrap();
@@ -182,8 +182,8 @@ where
     (mean / share - 1.0, (mean - share) / se)
 }
 
-/// The rows of `profile` from `first` to `last` (labels), as a table of
-/// relative error and z; and the largest |z| over all its bins.
+/// The bins `rows` of `profile` as a table of relative error and z, into
+/// `out`; returns the largest |z| over all its bins.
 fn table(profile: &Profile, rows: std::ops::Range<usize>, what: &str, out: &mut String) -> f64 {
     let errors = profile.errors();
     writeln!(out, "| {what} | relative error | z |\n|---|---:|---:|").unwrap();

@@ -49,7 +49,7 @@ const FAMILY_ALPHA: f64 = 1e-3;
 /// Planar systems tested.
 const PLANAR_SYSTEMS: usize = 3;
 /// Shifts per raster of the stripe test.
-const STRIPE_RUNS: usize = 400;
+const STRIPE_RUNS: usize = 1000;
 /// Rasters and systems of the stripe test.
 const STRIPE_CASES: usize = 2 * 2;
 /// Statistics in the whole file (the Bonferroni divisor).
@@ -409,11 +409,11 @@ fn planar_samples_are_unbiased_on_hard_edged_rasters() {
 /// times the background, 4 pixels of 256 wide, 94 % of the mass; and a
 /// step of 100, half the square) over `STRIPE_RUNS` random shifts at N =
 /// 1024: the count in the bright part has the bright part's share. The
-/// mean count carries a standard error of about 0.01 % of it, so it sees
-/// the dim side's share drift by 0.2 %. It caught samples that landed
-/// outside their tile's region: the G-hexomino put 0.12 % too many
-/// samples in the stripe (13.5 standard errors over 1000 shifts, 2 % too
-/// few on the dim side). Penrose is left out: it keeps a bias of this
+/// mean count of the stripe carries a standard error of about 0.013 % of
+/// it (0.2 % of the dim side's), and the test rejects at about 5 of them.
+/// It caught samples that landed outside their tile's region: the
+/// G-hexomino put 0.12 % too many samples in the stripe (13.5 standard
+/// errors over 1000 shifts, 2 % too few on the dim side). Penrose is left out: it keeps a bias of this
 /// kind, 0.3 % in a 16-pixel stripe of 100 (docs/DESIGN.md, the terminal
 /// rule).
 #[test]

@@ -541,7 +541,8 @@ fn in_box(region: &PlaneRegion, p: DVec2) -> bool {
 /// the density where it lands, so a bound over a region that misses it
 /// caps the keep probability below the density there (the offsets reach
 /// up to 9.9 cells past a G-hexomino tile's cells in its sparsest bins).
-/// Fails with the cells' box: 12 % of P-pentomino samples lie outside it.
+/// Fails with the cells' box: 12-15 % of the P-pentomino's samples on
+/// levels 1-6 lie outside it.
 #[test]
 fn regions_hold_every_sample_of_their_subtree() {
     for (name, tiling) in systems() {
@@ -549,7 +550,7 @@ fn regions_hold_every_sample_of_their_subtree() {
             .map(|b| tiling.lut().bin_fraction(b))
             .collect();
         let mut rng = SplitMix64::new(5);
-        for tile in tiling.tiles(1) {
+        for tile in tiling.tiles(0).into_iter().chain(tiling.tiles(1)) {
             let region = tiling.region(&tile);
             let mut below = vec![tile];
             for depth in 0..3 {
@@ -769,12 +770,13 @@ fn cli_samples_a_png_file_and_its_inverse() {
     assert_eq!(out.status.code(), Some(2));
 }
 
-/// How far the offset tables carry points beyond their tile's bounding box,
-/// in cells, over every tile of the first levels and 40 density fractions
-/// (printed with `--nocapture`): the planar tables are relaxed without a
-/// room around the tile, so points may leave it. The G-hexomino's go
-/// furthest at its lowest fractions, where one point in 40 to 81 tiles is
-/// kept and the kept points lie about 20 cells apart.
+/// How far the offset tables carry points beyond their tile's cells'
+/// bounding box, in cells, over every tile of the first levels and 40
+/// density fractions (printed with `--nocapture`): the planar tables are
+/// relaxed without a room around the tile, so points may leave it (and a
+/// tile's region grows to hold them). The G-hexomino's go furthest at its
+/// lowest fractions, where one point in 40 to 81 tiles is kept and the
+/// kept points lie about 20 cells apart.
 #[test]
 fn offsets_stay_near_their_tiles() {
     for (system, tiling) in systems() {
@@ -787,14 +789,23 @@ fn offsets_stay_near_their_tiles() {
         for level in levels {
             for tile in tiling.tiles(level) {
                 let r = tiling.region(&tile);
+                let half = DVec2::splat(r.cell / 2.0);
+                let lo = r
+                    .centres()
+                    .iter()
+                    .fold(DVec2::INFINITY, |a, &c| a.min(c - half));
+                let hi = r
+                    .centres()
+                    .iter()
+                    .fold(DVec2::NEG_INFINITY, |a, &c| a.max(c + half));
                 for k in 1..=40 {
                     let p = tiling.sample(&tile, k as f64 / 40.0);
-                    let out = (r.lo - p).max(p - r.hi).max_element() / r.cell;
+                    let out = (lo - p).max(p - hi).max_element() / r.cell;
                     worst = worst.max(out);
                 }
             }
         }
-        eprintln!("{system:?}: points reach {worst:.2} cells beyond their tile's box");
+        eprintln!("{system:?}: points reach {worst:.2} cells beyond their tile's cells' box");
         let bound = if tiling.lut().arity() == 4 { 3.0 } else { 11.0 };
         assert!(worst < bound, "{system:?}: {worst}");
     }

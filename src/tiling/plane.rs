@@ -10,8 +10,8 @@
 //! ([`PlaneLut`]); `tessera lut build --system ghexomino|ppentomino` makes it.
 //!
 //! The offsets were optimised on the torus (the root patch tiles the plane
-//! periodically), so a point pushed across the square's border re-enters on
-//! the opposite side: every point lies in `[0, 1)^2`.
+//! periodically); a point an offset pushes across the square's border is
+//! mirrored back inside (`mirror_unit`), so every point lies in `[0, 1)^2`.
 
 use crate::lut::{plane_lut, PlaneLut, PlaneSystem};
 use crate::polyomino::{Lattice, Orientation, Placement, Shape};
@@ -55,15 +55,17 @@ pub struct PlaneTile {
 /// ```
 /// use tessera::tiling::{plane::PlaneTiling, TileSystem};
 /// let t = PlaneTiling::ppentomino();
-/// let r = t.region(&t.roots()[0]);
+/// let root = t.roots()[0];
+/// let r = t.region(&root);
 /// assert_eq!(r.count, 5);
-/// assert!(r.centres().iter().all(|c| c.cmpgt(r.lo).all() && c.cmplt(r.hi).all()));
+/// let sample = t.sample(&root, 0.3);
+/// assert!(sample.cmpge(r.lo).all() && sample.cmple(r.hi).all());
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct PlaneRegion {
-    /// Lower corner of the box.
+    /// Lower corner of the box (it may reach past the unit square).
     pub lo: DVec2,
-    /// Upper corner of the box.
+    /// Upper corner of the box (it may reach past the unit square).
     pub hi: DVec2,
     /// Side of one cell.
     pub cell: f64,
@@ -157,37 +159,32 @@ struct Frame {
 
 /// The box a tile's region gives, per class and orientation: the cells'
 /// box grown to hold the tile's samples in every bin (the optimised
-/// offsets carry points into the neighbours' room, up to 2.19 cells on
-/// the shipped P-pentomino table and 9.87 on the G-hexomino's, in its
-/// sparsest bins) and its descendants' (inside its cells, and past theirs
-/// by at most `reach / scale`, `reach` the farthest any offset leaves its
-/// box). A bound over the cells alone let a sample land where the density
-/// exceeds its tile's bound, and the tile's keep probability saturated
-/// there (scratch, 1000 random shifts of a 256x256 raster with a bright
-/// vertical stripe, x1000 and 4 pixels wide, N = 1024: the G-hexomino put
-/// 0.12 % too many samples in the stripe, 13.5 standard errors, and 0.01 %
-/// with these boxes, 0.7; a x100 step at N = 16384, 26.6 and 0.1).
+/// offsets carry points into the neighbours' room) and its descendants'
+/// (inside its cells, and past theirs by at most `reach / scale`, `reach`
+/// the farthest any offset leaves its box). A density bounded over less
+/// would see samples land above their tile's bound, whose keep
+/// probability then saturates: a bias (DESIGN.md, Planar polyominoes).
 fn sample_boxes(
     frames: &[Frame; 8],
     offsets: &[[f64; 2]],
     bins: usize,
     scale: Lattice,
 ) -> Vec<[DVec2; 2]> {
-    let place = |o: Orientation, offset: [f64; 2]| DVec2::from(o.apply_f64(offset));
+    let turn = |o: Orientation, offset: [f64; 2]| DVec2::from(o.apply_f64(offset));
     let mut reach: f64 = 0.0;
     for (frame, o) in frames.iter().zip(Orientation::ALL) {
         for &offset in offsets {
-            let p = place(o, offset);
+            let p = turn(o, offset);
             reach = reach.max((frame.lo - p).max(p - frame.hi).max_element());
         }
     }
-    let below = reach / scale as f64;
+    let descendant_margin = reach / scale as f64;
     let mut boxes = Vec::with_capacity(offsets.len() / bins * 8);
     for class in offsets.chunks(bins) {
         for (frame, o) in frames.iter().zip(Orientation::ALL) {
-            let (mut lo, mut hi) = (frame.lo - below, frame.hi + below);
+            let (mut lo, mut hi) = (frame.lo - descendant_margin, frame.hi + descendant_margin);
             for &offset in class {
-                let p = place(o, offset);
+                let p = turn(o, offset);
                 (lo, hi) = (lo.min(p), hi.max(p));
             }
             boxes.push([lo, hi]);
@@ -220,6 +217,22 @@ impl Frame {
             hi: hi + 1.0,
         }
     }
+}
+
+/// The box `lo..hi` grown to hold the mirror images (`mirror_unit`) of its
+/// parts outside the unit square, where samples carried past the border
+/// land.
+#[inline(always)]
+fn mirrored_box(mut lo: DVec2, mut hi: DVec2) -> (DVec2, DVec2) {
+    for axis in 0..2 {
+        if hi[axis] > 1.0 {
+            lo[axis] = lo[axis].min(2.0 - hi[axis]);
+        }
+        if lo[axis] < 0.0 {
+            hi[axis] = hi[axis].max(-lo[axis]);
+        }
+    }
+    (lo, hi)
 }
 
 impl PlaneTiling {
@@ -587,9 +600,10 @@ impl TileSystem for PlaneTiling {
         for (cell, &centre) in cells.iter_mut().zip(&frame.centres) {
             *cell = (origin + centre) * s;
         }
+        let (lo, hi) = mirrored_box((origin + lo) * s, (origin + hi) * s);
         PlaneRegion {
-            lo: (origin + lo) * s,
-            hi: (origin + hi) * s,
+            lo,
+            hi,
             cell: s,
             cells,
             count: frame.count,
