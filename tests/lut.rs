@@ -19,6 +19,24 @@ fn the_embedded_table_is_valid() {
     assert_eq!(SphereLut::from_bytes(bytes).unwrap(), *sphere_lut());
 }
 
+/// The embedded table's sample reach, kept in the code so that no request
+/// decodes the whole table to measure it, is what its offsets measure.
+#[test]
+fn the_embedded_sample_reach_holds() {
+    use std::sync::Arc;
+    use tessera::tiling::sphere::SphereTiling;
+    let bytes = include_bytes!("../luts/sphere.lut");
+    let measured = SphereTiling::new(Arc::new(SphereLut::from_bytes(bytes).unwrap()));
+    let embedded = SphereTiling::default();
+    for level in 0..=12 {
+        assert_eq!(
+            measured.sample_reach(level),
+            embedded.sample_reach(level),
+            "level {level}: update EMBEDDED_REACH in src/tiling/sphere.rs"
+        );
+    }
+}
+
 #[test]
 fn bad_files_are_refused_with_a_reason() {
     let bytes = sphere_lut().to_bytes();

@@ -395,8 +395,10 @@ impl Density<SphereRegion> for HealpixMap {
         let px = &*self.pixels;
         let side = region.cell_side();
         if side.is_finite() {
-            // a tile: the box of its cells, exact in face coordinates
-            let h = side / 2.0 + MARGIN;
+            // a tile: the box of its cells and of the samples its bound
+            // covers, widened by their warp (`box_max` refuses a box that
+            // leaves the face)
+            let h = side / 2.0 + region.spill + reach(region.face, region.warp);
             let (mut x, mut y) = (
                 [f64::INFINITY, -f64::INFINITY],
                 [f64::INFINITY, -f64::INFINITY],

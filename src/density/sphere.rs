@@ -313,10 +313,10 @@ fn clean(v: f64) -> f64 {
 
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        // every point of a tile lies within `cell_reach` of one of its five
-        // cell centres, a third of the way the cap's centre reaches: from
-        // their largest value the bound grows three times less (a bare cap
-        // is known only by its centre)
+        // every sample the bound covers lies within `cell_reach` of one of
+        // the tile's five cell centres, nearer than the cap's centre
+        // reaches: from their largest value the bound grows less (a bare
+        // cap is known only by its centre)
         let reach = region.cell_reach();
         let (value, least, distance) = if reach < region.radius {
             let values = region.probes().map(|p| clean((self.f)(p)));
@@ -475,6 +475,8 @@ impl<D> Rotated<D> {
             radius: region.radius,
             face: centre.face,
             cells: [[centre.x, centre.y]; 5],
+            spill: 0.0,
+            warp: 0.0,
         }
     }
 }

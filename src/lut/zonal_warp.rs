@@ -120,6 +120,53 @@ impl ZonalWarp {
             .sum()
     }
 
+    /// A bound on the angle (rad) the warp moves a point by. With `M` the
+    /// largest `|g|`, `z = cos θ` moves by `(1 - z²) |g(z)|`, and by the
+    /// mean value theorem the angle by that over `sin ξ`, `ξ` between the
+    /// two colatitudes. Sine is concave there, so `sin ξ` is at least the
+    /// smaller of the two sines, and `sin²θ' >= sin²θ (1 - 2M - M²)`: the
+    /// angle is at most `sin θ |g(z)| / sqrt(1 - 2M - M²)`. Both maxima
+    /// are bounded interval by interval on a grid: `|g|` by its larger end
+    /// plus the most it changes within half the step (`|P_k'| <= k (k +
+    /// 1) / 2` on `[-1, 1]`), `sin θ` by its larger end (1 across the
+    /// equator). `g` is largest at the poles, where nothing moves: the
+    /// sum of `|a_k|` would be several times looser for the table's warps. A warp
+    /// with `M` past the root of that factor gets `pi`.
+    ///
+    /// # Example
+    /// ```
+    /// use glam::DVec3;
+    /// let warp = tessera::lut::ZonalWarp::new([1e-3, -2e-3, 0.0, 0.0, 0.0, 0.0]);
+    /// let p = DVec3::new(0.6, 0.0, 0.8);
+    /// assert!(warp.apply(p).angle_between(p) <= warp.move_bound());
+    /// assert!(warp.move_bound() < 3.1e-3);
+    /// ```
+    pub fn move_bound(&self) -> f64 {
+        const STEPS: usize = 4096;
+        let step = 2.0 / STEPS as f64;
+        let slope: f64 = (self.legendre.iter().enumerate())
+            .map(|(k, a)| a.abs() * (k * (k + 1)) as f64 / 2.0)
+            .sum();
+        let (mut most_g, mut most_move) = (0.0f64, 0.0f64);
+        let mut g_left = self.g(-1.0).abs();
+        for i in 0..STEPS {
+            let (left, right) = (-1.0 + i as f64 * step, -1.0 + (i + 1) as f64 * step);
+            let g_right = self.g(right).abs();
+            let g = g_left.max(g_right) + slope * step / 2.0;
+            let sin = match left <= 0.0 && right >= 0.0 {
+                true => 1.0,
+                false => (1.0 - left.abs().min(right.abs()).powi(2)).sqrt(),
+            };
+            (most_g, most_move) = (most_g.max(g), most_move.max(sin * g));
+            g_left = g_right;
+        }
+        let shrink = 1.0 - 2.0 * most_g - most_g * most_g;
+        match shrink > 0.0 {
+            true => most_move / shrink.sqrt(),
+            false => std::f64::consts::PI,
+        }
+    }
+
     /// `g(z)`, by Horner's rule.
     #[inline]
     fn g(&self, z: f64) -> f64 {
@@ -186,6 +233,18 @@ mod tests {
             }
             let above = (z + dz).min(1.0);
             prop_assert!(warp.apply(at(above)).z >= p.z);
+        }
+
+        /// No point moves farther than the move bound (near the poles too,
+        /// where `z` moves least for the angle).
+        #[test]
+        fn a_warp_moves_no_point_past_its_move_bound(
+            a in proptest::array::uniform6(-0.053f64..0.053),
+            z in prop_oneof![-1.0f64..1.0, 0.999f64..1.0, -1.0f64..-0.999],
+        ) {
+            let warp = ZonalWarp::new(a);
+            let p = DVec3::new((1.0 - z * z).sqrt(), 0.0, z);
+            prop_assert!(warp.apply(p).angle_between(p) <= warp.move_bound() * (1.0 + 1e-12));
         }
     }
 }

@@ -21,7 +21,7 @@ use crate::tiling::{code_value, digit_blocks, span, Code, TileSystem};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::ops::Range;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Cells along a face edge at level 0 (HEALPix Nside of the root patch).
 pub const PATCH_SIDE: Lattice = 10;
@@ -73,18 +73,24 @@ pub struct SphereTile {
 /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
 /// let sphere = SphereTiling::default();
 /// let region = sphere.region(&sphere.roots()[0]);
-/// assert!(region.radius > 0.0 && region.radius < 0.5);
+/// assert!(region.radius > 0.0 && region.radius < 0.6);
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct SphereRegion {
     /// The tile's centroid, in face coordinates (see [`SphereRegion::center`]).
     pub centroid: FacePoint,
-    /// Angular radius (rad) of a cap around `center` containing the tile.
+    /// Angular radius (rad) of a cap around `center` holding the tile and
+    /// the samples its bound covers ([`SampleReach`]).
     pub radius: f64,
     /// Base face.
     pub face: u8,
     /// Face coordinates of the five cell centres.
     pub cells: [[f64; 2]; 5],
+    /// How far (face coordinates) those samples land past the cells'
+    /// squares, in either coordinate, before their zonal warp.
+    pub spill: f64,
+    /// How far (rad) a zonal warp then moves them.
+    pub warp: f64,
 }
 
 impl SphereRegion {
@@ -116,21 +122,24 @@ impl SphereRegion {
             .map(|[x, y]| FacePoint::new(self.face, x, y).to_vec())
     }
 
-    /// How far (rad) a point of the tile can lie from the nearest of its
-    /// five cell centres ([`SphereRegion::probes`]): half a cell's
-    /// diagonal, stretched by at most [`FACE_LIPSCHITZ`] onto the sphere,
-    /// about a third of the cap's radius. Infinite for a bare cap (see
+    /// How far (rad) a sample the region's bound covers can lie from the
+    /// nearest of its five cell centres ([`SphereRegion::probes`]): within
+    /// `side / 2 + spill` of one in either face coordinate, so within
+    /// `sqrt 2` times that, stretched by at most [`FACE_LIPSCHITZ`] onto
+    /// the sphere, and then warped. Infinite for a bare cap (see
     /// [`SphereRegion::cell_side`]).
     ///
     /// # Example
     /// ```
     /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
     /// let sphere = SphereTiling::default();
-    /// let region = sphere.region(&sphere.roots()[0]);
-    /// assert!(region.cell_reach() < 0.4 * region.radius);
+    /// let tile = sphere.tile_with_code(9, 12_345).unwrap();
+    /// let region = sphere.region(&tile);
+    /// assert!(region.cell_reach() < 0.7 * region.radius);
     /// ```
     pub fn cell_reach(&self) -> f64 {
-        FACE_LIPSCHITZ * std::f64::consts::FRAC_1_SQRT_2 * self.cell_side()
+        let half_width = self.cell_side() / 2.0 + self.spill;
+        FACE_LIPSCHITZ * std::f64::consts::SQRT_2 * half_width + self.warp
     }
 
     /// Side of the tile's cells in face coordinates: the smallest step
@@ -177,6 +186,9 @@ pub struct SphereTiling {
     child_of_digit: [[u8; 4]; 2],
     /// `shape.centroid()`, cached for [`TileSystem::region`].
     centroid: [f64; 2],
+    /// [`SphereTiling::sample_reach`] of each table level, measured from
+    /// the table when a region first needs it.
+    reach: OnceLock<Vec<SampleReach>>,
 }
 
 impl Default for SphereTiling {
@@ -202,7 +214,12 @@ impl SphereTiling {
             roots_by_code: Vec::new(),
             child_of_digit: [[0; 4]; 2],
             centroid: Shape::p_pentomino().centroid(),
+            reach: OnceLock::new(),
         };
+        if Arc::ptr_eq(&tiling.lut, &crate::lut::sphere_lut()) {
+            // measuring it would decode every offset table (11 MB)
+            let _ = tiling.reach.set(EMBEDDED_REACH.to_vec());
+        }
         let mut roots = tiling.roots();
         roots.sort_by_key(|t| t.code);
         tiling.roots_by_code = roots;
@@ -386,7 +403,164 @@ impl SphereTiling {
     pub fn shape(&self) -> &Shape {
         &self.shape
     }
+
+    /// How far the samples that the bound of a tile of `level` covers
+    /// land from it ([`SampleReach`]): what its region holds.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::sphere::SphereTiling;
+    /// let reach = SphereTiling::default().sample_reach(3);
+    /// assert!(reach.from_centroid >= 2.03 && reach.past_cells >= 0.0);
+    /// ```
+    pub fn sample_reach(&self, level: u32) -> SampleReach {
+        let reach = self.reach.get_or_init(|| self.measure_reach());
+        reach[(level as usize).min(reach.len() - 1)]
+    }
+
+    /// [`SphereTiling::sample_reach`] of every table level (the last
+    /// serving every deeper one), from the table's offsets.
+    fn measure_reach(&self) -> Vec<SampleReach> {
+        let levels = self.lut.tables.len().max(1);
+        let own: Vec<SampleReach> = (0..levels).map(|level| self.own_reach(level)).collect();
+        // a child's centroid, in its parent's cells (children are half
+        // their parent's size), from the parent's
+        let centroid = self.centroid;
+        let child_centroid = (self.lut.rules.iter())
+            .flat_map(|rule| &rule.children)
+            .map(|child| {
+                let c = child.to_lattice(centroid);
+                (c[0] / 2.0 - centroid[0]).hypot(c[1] / 2.0 - centroid[1])
+            })
+            .fold(0.0, f64::max);
+        (0..levels)
+            .map(|level| {
+                // the last table level's children read it again
+                let child = own[(level + 1).min(levels - 1)];
+                SampleReach {
+                    from_centroid: (own[level].from_centroid)
+                        .max(child_centroid + child.from_centroid / 2.0),
+                    past_cells: own[level].past_cells.max(child.past_cells / 2.0),
+                    warp: own[level].warp.max(child.warp),
+                }
+            })
+            .collect()
+    }
+
+    /// How far a level's own samples land: its offsets in every bin, its
+    /// sibling fills and drop moves, and its zonal warps.
+    fn own_reach(&self, level: usize) -> SampleReach {
+        let lut = &*self.lut;
+        // the distinct stored pairs (an `i8` pair each) are few
+        let mut seen = vec![false; 1 << 16];
+        let mut hold = |stored: [i8; 2]| {
+            seen[(stored[0] as u8 as usize) << 8 | stored[1] as u8 as usize] = true;
+        };
+
+        let mut warp = 0.0f64;
+        for (bin, table) in lut.tables.get(level).into_iter().flatten().enumerate() {
+            table.iter().for_each(|&pair| hold(pair));
+            let moves = lut.drop_moves.get(level).and_then(|bins| bins.get(bin));
+            for (row, _, shift) in moves.into_iter().flat_map(|moves| moves.iter()) {
+                hold([0, 1].map(|c| table[row][c].wrapping_add(shift[c])));
+            }
+            warp = warp.max(lut.zonal_warp(level, bin).move_bound());
+        }
+        if let Some(fills) = lut.fills.get(level) {
+            fills.iter().for_each(|&pair| hold(pair));
+        }
+        let cells = self.shape.cells();
+        let mut reach = SampleReach {
+            from_centroid: PENTOMINO_RADIUS,
+            past_cells: 0.0,
+            warp,
+        };
+        for (at, _) in seen.iter().enumerate().filter(|(_, &seen)| seen) {
+            let p = crate::lut::dequantise([(at >> 8) as u8 as i8, at as u8 as i8]);
+            let from_centroid = (p[0] - self.centroid[0]).hypot(p[1] - self.centroid[1]);
+            // Chebyshev distance past the nearest cell, each `[x, x + 1]^2`
+            let past = |&(x, y): &(Lattice, Lattice)| {
+                let d = |v: f64, lo: f64| (lo - v).max(v - lo - 1.0).max(0.0);
+                d(p[0], x as f64).max(d(p[1], y as f64))
+            };
+            let past_cells = cells.iter().map(past).fold(f64::INFINITY, f64::min);
+            reach.from_centroid = reach.from_centroid.max(from_centroid);
+            reach.past_cells = reach.past_cells.max(past_cells);
+        }
+        reach
+    }
 }
+
+/// How far the samples that a tile's bound covers land from it: its own,
+/// in every importance bin, with every sibling fill, drop move and zonal
+/// warp, and its children's, which its bound thins when it makes them
+/// terminal. A region that held less would let a sample land where the
+/// density exceeds the bound its keep probability was drawn against: a
+/// bias (DESIGN, "The terminal rule").
+///
+/// # Example
+/// ```
+/// use tessera::tiling::sphere::{SampleReach, SphereTiling};
+/// let reach: SampleReach = SphereTiling::default().sample_reach(3);
+/// assert!(reach.past_cells < reach.from_centroid && reach.warp < 1e-2);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SampleReach {
+    /// Largest distance from the tile's centroid, in its cells: at least
+    /// the pentomino's own outline, which the region holds too.
+    pub from_centroid: f64,
+    /// Largest distance past the nearest of the tile's five cells, in
+    /// either coordinate, in its cells: 0 while every sample lies in them.
+    pub past_cells: f64,
+    /// Largest move (rad) of a zonal warp.
+    pub warp: f64,
+}
+
+/// [`SphereTiling::sample_reach`] of the table in `luts/sphere.lut`, level
+/// by level: `the_embedded_sample_reach_holds` (tests/lut.rs) measures it
+/// and fails when the table changes.
+const EMBEDDED_REACH: [SampleReach; 8] = [
+    SampleReach {
+        from_centroid: 3.005203820042827,
+        past_cells: 1.6749999999999998,
+        warp: 0.03178728715298326,
+    },
+    SampleReach {
+        from_centroid: 3.4428367663890196,
+        past_cells: 1.85,
+        warp: 0.018743236362983164,
+    },
+    SampleReach {
+        from_centroid: 3.4354766772603766,
+        past_cells: 2.2,
+        warp: 0.00708551301383304,
+    },
+    SampleReach {
+        from_centroid: 4.292580808790907,
+        past_cells: 2.25,
+        warp: 0.002553622621022408,
+    },
+    SampleReach {
+        from_centroid: 4.424505622100621,
+        past_cells: 2.375,
+        warp: 0.0012291791488298449,
+    },
+    SampleReach {
+        from_centroid: 4.564263357870577,
+        past_cells: 2.6,
+        warp: 0.000371549497725746,
+    },
+    SampleReach {
+        from_centroid: 4.669047011971501,
+        past_cells: 2.7,
+        warp: 7.65233841410274e-5,
+    },
+    SampleReach {
+        from_centroid: 3.079163847540433,
+        past_cells: 0.9750000000000001,
+        warp: 0.0,
+    },
+];
 
 /// Spacings (of a bin's set) within which a tile's ring twins, the tiles
 /// whose codes differ from its own in the last two bits only, share the
@@ -529,11 +703,16 @@ impl TileSystem for SphereTiling {
             [p.x, p.y]
         };
         let nside = Self::nside(tile.level as u32) as f64;
+        let reach = self.sample_reach(tile.level as u32);
         SphereRegion {
             centroid: self.face_point(tile, centroid),
-            radius: FACE_LIPSCHITZ * PENTOMINO_RADIUS / nside,
+            // face points clamp onto the face, which only brings them
+            // nearer the centroid and the cells
+            radius: FACE_LIPSCHITZ * reach.from_centroid / nside + reach.warp,
             face: tile.face,
             cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
+            spill: reach.past_cells / nside,
+            warp: reach.warp,
         }
     }
 
