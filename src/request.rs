@@ -185,7 +185,7 @@ impl SphereRequest {
             // a window visits only the tiles reaching it
             let near = engine::collect_within(&tiling, &**density, self.count as f64, &|r| {
                 window.reaches(r)
-            });
+            })?;
             return Ok(near
                 .into_iter()
                 .map(|s| s.position)

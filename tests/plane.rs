@@ -258,7 +258,7 @@ fn streaming_recursion_and_the_uniform_fast_path_agree() {
             let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
             assert_eq!(streamed, fast, "{system:?}, n = {n}");
             // the general recursion, ranked by sorting, finds the same set in the same order
-            let mut recursed = engine::collect(&tiling, &Uniform, n as f64);
+            let mut recursed = engine::collect(&tiling, &Uniform, n as f64).unwrap();
             recursed.sort_by(|a, b| a.rank.total_cmp(&b.rank));
             assert_eq!(recursed, fast, "{system:?}, n = {n}");
         }

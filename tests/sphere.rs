@@ -528,6 +528,43 @@ where
         .collect()
 }
 
+/// A density whose bound falls below it where samples land is refused,
+/// not sampled with a bias: a von Mises-Fisher lobe of `kappa` 200 given
+/// a Lipschitz constant of 1 (its steepest slope is about 8.6), in a
+/// progressive request, an unsorted one and one computed in batches
+/// (over 2^22). With its true constant the same requests succeed.
+#[test]
+fn a_density_above_its_bound_is_an_error() {
+    let kappa = 200.0;
+    let lobe = move |v: DVec3| (kappa * (v.z - 1.0)).exp();
+    let steepest = (kappa / std::f64::consts::E).sqrt();
+    for (lipschitz, fails) in [(1.0, true), (steepest * 1.01, false)] {
+        for (n, order) in [
+            (20_000, Order::Progressive),
+            (20_000, Order::Unsorted),
+            ((1 << 22) + 1, Order::Progressive),
+        ] {
+            let density = SphereFn::new(lobe, lipschitz).unwrap();
+            let result = Sampler::sphere()
+                .density(density)
+                .count(n)
+                .order(order)
+                .generate();
+            match (fails, result) {
+                (true, Err(e)) => {
+                    let why = e.to_string();
+                    assert!(why.contains("bound") && why.contains("Lipschitz"), "{why}");
+                }
+                (false, Ok(samples)) => assert_eq!(samples.len(), n),
+                (fails, result) => panic!(
+                    "Lipschitz {lipschitz}, N = {n}, {order:?}: expected failure {fails}, got {:?}",
+                    result.map(|s| s.len())
+                ),
+            }
+        }
+    }
+}
+
 #[test]
 fn smooth_densities_past_the_per_tile_levels_keep_their_points_apart() {
     // under a smooth density neighbouring tiles take neighbouring bins of
@@ -725,7 +762,7 @@ fn uniform_fast_path_streaming_and_recursion_agree() {
         let streamed: Vec<_> = engine::stream(&tiling, n).unwrap().collect();
         assert_eq!(fast, streamed);
         // the general recursion, ranked by sorting, finds the same set in the same order
-        let mut recursed = engine::collect(&tiling, &Uniform, n as f64);
+        let mut recursed = engine::collect(&tiling, &Uniform, n as f64).unwrap();
         recursed.sort_by(|a, b| a.rank.total_cmp(&b.rank));
         assert_eq!(fast, recursed, "n = {n}");
     }

@@ -104,7 +104,7 @@ fn a_millionth_of_a_degree_cap_at_the_pole_holds_thousands_of_points() {
     let n = 3e7;
     let expected = cap.mass_fraction() * n;
     let tiling = SphereTiling::default();
-    let near = engine::collect_within(&tiling, &cap, n, &|r| cap.reaches(r));
+    let near = engine::collect_within(&tiling, &cap, n, &|r| cap.reaches(r)).unwrap();
     let inside: Vec<DVec3> = near
         .iter()
         .map(|s| s.position)
@@ -146,8 +146,8 @@ fn a_window_returns_exactly_the_full_sets_samples_in_it() {
             .filter(|s| window.contains(s.position))
             .collect()
     };
-    let near = engine::collect_within(&tiling, &bright, n, &|r| window.reaches(r));
-    let mut all = inside(engine::collect(&tiling, &bright, n));
+    let near = engine::collect_within(&tiling, &bright, n, &|r| window.reaches(r)).unwrap();
+    let mut all = inside(engine::collect(&tiling, &bright, n).unwrap());
     all.sort_by(|a, b| a.rank.total_cmp(&b.rank));
     assert!(all.len() > 1000);
     assert_eq!(inside(near), all);
@@ -160,7 +160,7 @@ fn windows_find_the_points_that_drop_moves_carried_out_of_their_tiles() {
     // and must still find every such point, at poles and seams too
     let tiling = SphereTiling::default();
     for n in [3000.0, 20_188.0, 120_000.0] {
-        let all = engine::collect(&tiling, &Uniform, n);
+        let all = engine::collect(&tiling, &Uniform, n).unwrap();
         for k in 0..100 {
             let lon = (k as f64 * 137.508) % 360.0 - 180.0;
             let lat = match k {
@@ -171,7 +171,8 @@ fn windows_find_the_points_that_drop_moves_carried_out_of_their_tiles() {
                     .to_degrees(),
             };
             let window = Cap::new(lon, lat, 2.0 + (k % 4) as f64, 1.0).unwrap();
-            let near = engine::collect_within(&tiling, &Uniform, n, &|r| window.reaches(r));
+            let near =
+                engine::collect_within(&tiling, &Uniform, n, &|r| window.reaches(r)).unwrap();
             let inside = |s: &&engine::Sample<DVec3>| window.contains(s.position);
             let (found, expected) = (
                 near.iter().filter(inside).count(),

@@ -40,7 +40,9 @@ impl Region for crate::tiling::sphere::SphereRegion {
 /// assert_eq!(d.mean(), 1.0);
 /// ```
 pub trait Density<R: Region>: Sync {
-    /// An upper bound of the density over the region (never below the truth).
+    /// An upper bound of the density over the region (never below the
+    /// truth: a request fails with an error where a sample lands on a
+    /// density above its tile's bound, as its samples would be biased).
     fn bound(&self, region: &R) -> f64;
     /// The density's average over the region (may be approximate).
     fn average(&self, region: &R) -> f64;

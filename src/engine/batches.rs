@@ -230,12 +230,18 @@ where
         let mut magnitude = super::first_magnitude(count, exact);
         let mut counted = Counted::new(system, density, magnitude);
         for _ in 0..super::MAGNITUDE_ROUNDS {
+            if let Some(ratio) = counted.walker.excess() {
+                return Err(super::bound_exceeded(ratio));
+            }
             let found = counted.found();
             if !exact || found >= count {
                 break;
             }
             magnitude *= super::growth(count, found);
             counted = Counted::new(system, density, magnitude);
+        }
+        if let Some(ratio) = counted.walker.excess() {
+            return Err(super::bound_exceeded(ratio));
         }
         let found = counted.found();
         if exact && found < count {

@@ -78,18 +78,29 @@ use walker::collect_parts;
 /// # Example
 /// ```
 /// use tessera::{density::Uniform, engine, tiling::sphere::SphereTiling};
-/// let all = engine::collect(&SphereTiling::default(), &Uniform, 960.0);
+/// let all = engine::collect(&SphereTiling::default(), &Uniform, 960.0).unwrap();
 /// assert_eq!(all.len(), 960);
 /// ```
-pub fn collect<S, D>(system: &S, density: &D, magnitude: f64) -> Vec<Sample<S::Point>>
+///
+/// # Errors
+/// Where a sample lands on a density above its tile's bound (see
+/// [`Density::bound`]).
+pub fn collect<S, D>(
+    system: &S,
+    density: &D,
+    magnitude: f64,
+) -> Result<Vec<Sample<S::Point>>, Error>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
     D: Density<S::Region> + ?Sized,
 {
     let mut parts = Vec::new();
-    collect_parts(system, density, magnitude, None, &mut parts, None);
-    parts.concat()
+    let collected = collect_parts(system, density, magnitude, None, &mut parts, None);
+    match collected.excess {
+        Some(ratio) => Err(bound_exceeded(ratio)),
+        None => Ok(parts.concat()),
+    }
 }
 
 /// A conservative test of whether a tile (its region) reaches into a window.
@@ -114,8 +125,8 @@ pub type Window<'a, R> = dyn Fn(&R) -> bool + Sync + 'a;
 /// use tessera::{density::{sphere::Cap, Uniform}, engine, tiling::sphere::SphereTiling};
 /// let sphere = SphereTiling::default();
 /// let window = Cap::new(30.0, 10.0, 5.0, 1.0).unwrap();
-/// let near = engine::collect_within(&sphere, &Uniform, 1e6, &|r| window.reaches(r));
-/// let all = engine::collect(&sphere, &Uniform, 1e6);
+/// let near = engine::collect_within(&sphere, &Uniform, 1e6, &|r| window.reaches(r)).unwrap();
+/// let all = engine::collect(&sphere, &Uniform, 1e6).unwrap();
 /// let inside = |s: &&engine::Sample<glam::DVec3>| window.contains(s.position);
 /// assert_eq!(near.iter().filter(inside).count(), all.iter().filter(inside).count());
 /// assert!(near.len() < all.len() / 100);
@@ -125,7 +136,7 @@ pub fn collect_within<S, D>(
     density: &D,
     magnitude: f64,
     overlaps: &Window<'_, S::Region>,
-) -> Vec<Sample<S::Point>>
+) -> Result<Vec<Sample<S::Point>>, Error>
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
@@ -134,7 +145,7 @@ where
     let (mut parts, mut samples, mut histograms) = (Vec::new(), Vec::new(), Vec::new());
     let buckets = RankBuckets::for_magnitude(magnitude);
     let counted = Some((buckets, &mut histograms));
-    let in_range = collect_parts(
+    let collected = collect_parts(
         system,
         density,
         magnitude,
@@ -142,14 +153,17 @@ where
         &mut parts,
         counted,
     );
+    if let Some(ratio) = collected.excess {
+        return Err(bound_exceeded(ratio));
+    }
     by_rank(
         &parts,
         (buckets, &histograms),
-        in_range,
+        collected.in_range,
         usize::MAX,
         &mut samples,
     );
-    samples
+    Ok(samples)
 }
 
 /// Generates about `count` samples (exactly `count` when `exact`) following
@@ -411,21 +425,29 @@ where
     let mut collect = |magnitude: f64, parts: &mut Vec<_>| {
         let buckets = RankBuckets::for_magnitude(magnitude);
         let counted = Some((buckets, &mut *histograms));
-        (
-            buckets,
-            collect_parts(system, density, magnitude, None, parts, counted),
-        )
+        let collected = collect_parts(system, density, magnitude, None, parts, counted);
+        match collected.excess {
+            Some(ratio) => Err(bound_exceeded(ratio)),
+            None => Ok((buckets, collected.in_range)),
+        }
     };
-    let (mut buckets, mut in_range) = collect(magnitude, parts);
     let total = |parts: &[Vec<Sample<S::Point>>]| parts.iter().map(Vec::len).sum::<usize>();
+    let mut collected = collect(magnitude, parts);
     for _ in 0..MAGNITUDE_ROUNDS {
         let found = total(parts);
-        if !exact || found >= count {
+        if collected.is_err() || !exact || found >= count {
             break;
         }
         magnitude *= growth(count, found);
-        (buckets, in_range) = collect(magnitude, parts);
+        collected = collect(magnitude, parts);
     }
+    let (buckets, in_range) = match collected {
+        Ok(collected) => collected,
+        Err(e) => {
+            out.clear();
+            return Err(e);
+        }
+    };
     if exact && total(parts) < count {
         out.clear();
         return Err(too_few(total(parts), count));
@@ -439,6 +461,19 @@ where
         }
     }
     Ok(out)
+}
+
+/// The error of a request whose density exceeded its bound by `ratio`
+/// where a sample landed (see `Walker::excess`).
+fn bound_exceeded(ratio: f64) -> Error {
+    Error::Density(
+        "bound".into(),
+        format!(
+            "the density where a sample landed is {ratio:.6} times its bound over the sample's tile; \
+             Density::bound must never be below the density, or the samples are biased \
+             (a SphereFn: its Lipschitz constant is too small)"
+        ),
+    )
 }
 
 /// The magnitude a request of `count` samples starts from: with the

@@ -8,13 +8,22 @@ use crate::memory;
 use crate::tiling::{code_value, TileSystem};
 use rayon::prelude::*;
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// What [`collect_parts`] found besides the samples.
+pub(super) struct Collected {
+    /// False when some rank lies outside `[0, 1)` (never for the engine's
+    /// ranks; not checked without histograms).
+    pub(super) in_range: bool,
+    /// See [`Walker::excess`].
+    pub(super) excess: Option<f64>,
+}
 
 /// The accepted samples of each root's subtree, in root order, into
 /// `parts` (a list per run of consecutive roots, see [`chunk_roots`];
 /// their memory reused); with `histograms`, also each list's count of
 /// samples per rank bucket, taken while each root's samples are still in
-/// cache. False when some rank lies outside `[0, 1)`
-/// (never for the engine's ranks; not checked without `histograms`).
+/// cache.
 pub(super) fn collect_parts<S, D>(
     system: &S,
     density: &D,
@@ -22,7 +31,7 @@ pub(super) fn collect_parts<S, D>(
     window: Option<&Window<'_, S::Region>>,
     parts: &mut Vec<Vec<Sample<S::Point>>>,
     histograms: Option<(RankBuckets, &mut Vec<Vec<u32>>)>,
-) -> bool
+) -> Collected
 where
     S: TileSystem,
     S::Region: Region<Point = S::Point>,
@@ -54,7 +63,7 @@ where
     let (buckets, mut none) = (histograms.as_ref().map(|h| h.0), Vec::new());
     let counts = histograms.map_or(&mut none, |h| h.1);
     counts.resize_with(chunks.len(), Vec::new);
-    chunks
+    let in_range = chunks
         .par_iter()
         .zip(parts.par_iter_mut())
         .zip(counts.par_iter_mut())
@@ -73,7 +82,11 @@ where
             }
             in_range
         })
-        .reduce(|| true, |a, b| a && b)
+        .reduce(|| true, |a, b| a && b);
+    Collected {
+        in_range,
+        excess: walker.excess(),
+    }
 }
 /// Consecutive roots whose outputs share a list, by their expected sizes
 /// (`shares`): about [`LISTS_A_THREAD`] lists a thread, so that a large
@@ -118,6 +131,10 @@ pub(super) const LISTS_A_THREAD: usize = 8;
 /// The most samples reserved for a root's output before it is known
 /// (24 MB of planar samples).
 pub(super) const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
+/// How far (relative) a density may exceed its bound where a sample lands
+/// before the request fails ([`Walker::excess`]): rounding only. The
+/// shipped densities never exceed theirs.
+pub(super) const BOUND_TOLERANCE: f64 = 1e-9;
 pub(super) struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
@@ -136,6 +153,10 @@ pub(super) struct Walker<'a, S: TileSystem, D: ?Sized> {
     seed: u64,
     /// Only tiles this accepts are visited (see [`super::collect_within`]).
     window: Option<&'a Window<'a, S::Region>>,
+    /// The largest ratio, above 1, of the density where a sample landed
+    /// to its tile's bound (`f64` bits; 0 while none): see
+    /// [`Walker::excess`].
+    excess: AtomicU64,
 }
 impl<'a, S, D> Walker<'a, S, D>
 where
@@ -171,7 +192,29 @@ where
                 .unwrap_or(0)
                 .wrapping_mul(0x9E37_79B9_7F4A_7C15),
             window,
+            excess: AtomicU64::new(0),
         }
+    }
+
+    /// The largest ratio of the density where a sample landed to the
+    /// bound of its tile, when a density exceeded its bound by more than
+    /// rounding ([`BOUND_TOLERANCE`]). Such a density's samples are
+    /// biased: a candidate is kept with probability `density / capacity`
+    /// only if its bound is at least the density (see the module doc), and
+    /// otherwise with its bound's, too seldom. Seen only where a sample
+    /// lands, so a request can pass while another of the same density
+    /// fails.
+    pub(super) fn excess(&self) -> Option<f64> {
+        let ratio = f64::from_bits(self.excess.load(Ordering::Relaxed));
+        (ratio > 1.0 + BOUND_TOLERANCE).then_some(ratio)
+    }
+
+    /// Records that the density where a sample landed is `ratio` times
+    /// its tile's bound.
+    #[cold]
+    fn note_excess(&self, ratio: f64) {
+        // positive f64 bits order as the values do
+        self.excess.fetch_max(ratio.to_bits(), Ordering::Relaxed);
     }
 
     /// A density value (a bound or an average) in code units: `value *
@@ -408,6 +451,9 @@ where
             return;
         };
         let here = self.scaled(self.density.value(position));
+        if here > bound {
+            self.note_excess(here / bound);
+        }
         if threshold < here {
             out.push(Sample {
                 position,
