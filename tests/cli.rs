@@ -584,8 +584,8 @@ fn metric_keys_are_documented() {
 }
 
 /// `sphere --report` measures angles in units of the local spacing: on a
-/// uniform request that is `metrics`' normalisation, on a refined one it
-/// reads well above the uniform normalisation's collapse.
+/// uniform request that is `metrics`' normalisation, on a refined one the
+/// spacing its density's pdf gives each point, not the uniform one.
 #[test]
 fn report_normalises_by_the_local_density() {
     let dir = std::env::temp_dir().join(format!("tessera-report-{}", std::process::id()));
@@ -634,13 +634,34 @@ fn report_normalises_by_the_local_density() {
         "{separation} {uniform_separation}"
     );
     assert!((mesh - uniform_mesh).abs() < 1e-4, "{mesh} {uniform_mesh}");
-    // unnormalised, the dense cap's spacing reads as crowding
+    // on a refined request, by the cap's pdf at each point, where the
+    // uniform normalisation reads the dense cap's spacing as crowding
     let (separation, mesh, uniform_separation, uniform_mesh) = reported("cap:0,90,30,16");
+    use tessera::density::{sphere::Cap, Density};
+    let cap = Cap::new(0.0, 90.0, 30.0, 16.0).unwrap();
+    let pdf = |x: glam::DVec3| cap.value(x) / (4.0 * std::f64::consts::PI * cap.mean());
+    let points: Vec<glam::DVec3> = std::fs::read_to_string(file)
+        .unwrap()
+        .lines()
+        .map(|line| {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            glam::DVec3::new(v[0], v[1], v[2])
+        })
+        .collect();
+    let local = tessera::metrics::sphere::local_spacing(&points, pdf);
     assert!(
-        separation > 1.5 * uniform_separation,
+        (separation - local.separation).abs() < 1e-4,
+        "{separation} {local:?}"
+    );
+    assert!((mesh - local.mesh_ratio).abs() < 1e-3, "{mesh} {local:?}");
+    assert!(
+        (separation - uniform_separation).abs() > 0.1 * uniform_separation,
         "{separation} {uniform_separation}"
     );
-    assert!(mesh < 0.5 * uniform_mesh, "{mesh} {uniform_mesh}");
+    assert!(
+        (mesh - uniform_mesh).abs() > 0.1 * uniform_mesh,
+        "{mesh} {uniform_mesh}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

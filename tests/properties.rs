@@ -83,6 +83,9 @@ impl<T: TileSystem, F: Fn(&T, &T::Tile, T::Point, f64) -> bool + Sync> TileSyste
     fn region(&self, tile: &T::Tile) -> T::Region {
         self.inner.region(tile)
     }
+    fn placing_region(&self, tile: &T::Tile) -> Option<T::Region> {
+        self.inner.placing_region(tile)
+    }
     fn carries_sample(&self, tile: &T::Tile) -> bool {
         self.inner.carries_sample(tile)
     }

@@ -192,7 +192,7 @@ where
                 |(totals, mut sized, in_range, mut samples, mut counts), (k, start)| {
                     samples.clear();
                     counts.clear();
-                    walker.visit(start, f64::INFINITY, &mut samples);
+                    walker.visit(start, f64::INFINITY, f64::INFINITY, &mut samples);
                     let in_range = buckets.count_into(&samples, &mut counts) && in_range;
                     sized.push((k, samples.len()));
                     let mut totals = add(totals, &[]);
@@ -270,7 +270,7 @@ where
                 list.clear();
                 list.reserve_exact(*size);
                 for start in &starts[run.clone()] {
-                    self.walker.visit(start, f64::INFINITY, list);
+                    self.walker.visit(start, f64::INFINITY, f64::INFINITY, list);
                 }
             });
     }

@@ -76,7 +76,7 @@ where
             let mut in_range = true;
             for start in &starts[chunk.clone()] {
                 let from = out.len();
-                walker.visit(start, f64::INFINITY, out);
+                walker.visit(start, f64::INFINITY, f64::INFINITY, out);
                 // counted while the start's samples are still in cache
                 in_range &= buckets.is_none_or(|b| b.count_into(&out[from..], counts));
             }
@@ -317,8 +317,15 @@ where
     /// `parent_bound`: the parent's scaled bound, which bounds this tile
     /// too: a tile it already makes terminal needs no bound of its own (most
     /// tiles: those the recursion stops at), and one it also rejects is
-    /// skipped before its region is computed.
-    pub(super) fn visit(&self, tile: &S::Tile, parent_bound: f64, out: &mut Vec<Sample<S::Point>>) {
+    /// skipped before its region is computed. Such a tile is placed for
+    /// `parent_placing`, its parent's placing bound.
+    pub(super) fn visit(
+        &self,
+        tile: &S::Tile,
+        parent_bound: f64,
+        parent_placing: f64,
+        out: &mut Vec<Sample<S::Point>>,
+    ) {
         let level = self.system.level(tile);
         let capacity = self.capacities[level as usize];
         let terminal_by_parent = capacity >= parent_bound;
@@ -330,13 +337,27 @@ where
         // the region is built in place and lent (an `Option` of it would be
         // a copy of a large struct per tile)
         if self.constant.is_some() && self.window.is_none() {
-            self.decide(tile, level, capacity, parent_bound, None, out);
+            self.decide(
+                tile,
+                level,
+                capacity,
+                (parent_bound, parent_placing),
+                None,
+                out,
+            );
         } else {
             let region = self.system.region(tile);
             if self.window.is_some_and(|window| !window(&region)) {
                 return;
             }
-            self.decide(tile, level, capacity, parent_bound, Some(&region), out);
+            self.decide(
+                tile,
+                level,
+                capacity,
+                (parent_bound, parent_placing),
+                Some(&region),
+                out,
+            );
         }
     }
 
@@ -349,7 +370,7 @@ where
         tile: &S::Tile,
         level: u32,
         capacity: f64,
-        parent_bound: f64,
+        (parent_bound, parent_placing): (f64, f64),
         region: Option<&S::Region>,
         out: &mut Vec<Sample<S::Point>>,
     ) {
@@ -368,9 +389,31 @@ where
             if code + self.least_dither >= bound {
                 return; // not even the bound would keep it
             }
-            return self.emit(tile, level, code, bound, out);
+            let placing = match capacity >= parent_bound {
+                true => parent_placing,
+                false => self.placing_bound(tile, bound),
+            };
+            return self.emit(tile, level, code, bound, placing, out);
         }
-        self.visit_children(tile, level, bound, out);
+        let placing = match self.capacities[level as usize + 1] >= bound {
+            true => self.placing_bound(tile, bound),
+            false => bound,
+        };
+        self.visit_children(tile, level, bound, placing, out);
+    }
+
+    /// The scaled bound over the tile's placing region
+    /// ([`TileSystem::placing_region`]), at most its bound `bound`: what
+    /// picks the bin its sample, or its children's when it makes them
+    /// terminal, is placed for (see the module doc, Two bounds).
+    fn placing_bound(&self, tile: &S::Tile, bound: f64) -> f64 {
+        if self.constant.is_some() {
+            return bound;
+        }
+        match self.system.placing_region(tile) {
+            Some(region) => self.scaled(self.density.bound(&region)).min(bound),
+            None => bound,
+        }
     }
 
     /// A child whose parent's bound makes it terminal and does not reject
@@ -381,13 +424,13 @@ where
         tile: &S::Tile,
         level: u32,
         code: f64,
-        bound: f64,
+        (bound, placing): (f64, f64),
         out: &mut Vec<Sample<S::Point>>,
     ) {
         if self.window.is_some() || !self.system.carries_sample(tile) {
-            return self.visit(tile, bound, out);
+            return self.visit(tile, bound, placing, out);
         }
-        self.emit(tile, level, code, bound, out);
+        self.emit(tile, level, code, bound, placing, out);
     }
 
     /// The per-tile dither of a varying density's threshold: uniform in
@@ -417,6 +460,7 @@ where
         level: u32,
         code: f64,
         bound: f64,
+        placing: f64,
         out: &mut Vec<Sample<S::Point>>,
     ) {
         // (the reciprocal keeps the division off the chain from the
@@ -447,7 +491,7 @@ where
             return;
         }
         // the tiling may reach past the domain: no sample there
-        let Some(position) = place(bound) else {
+        let Some(position) = place(placing) else {
             return;
         };
         let here = self.scaled(self.density.value(position));
@@ -468,6 +512,7 @@ where
         tile: &S::Tile,
         level: u32,
         bound: f64,
+        placing: f64,
         out: &mut Vec<Sample<S::Point>>,
     ) {
         // children the bound already rejects (see `visit`'s first test) are
@@ -484,7 +529,13 @@ where
                 if code + self.least_dither >= bound {
                     break;
                 }
-                self.visit_terminal(&self.system.child(tile, i), level + 1, code, bound, out);
+                self.visit_terminal(
+                    &self.system.child(tile, i),
+                    level + 1,
+                    code,
+                    (bound, placing),
+                    out,
+                );
             }
             return;
         }
@@ -494,7 +545,7 @@ where
             {
                 continue;
             }
-            self.visit(&self.system.child(tile, i), bound, out);
+            self.visit(&self.system.child(tile, i), bound, placing, out);
         }
     }
 }
@@ -521,12 +572,12 @@ mod tests {
                 let walker = Walker::new(system, density, magnitude, None);
                 let (mut by_roots, mut by_starts) = (Vec::new(), Vec::new());
                 for root in system.roots() {
-                    walker.visit(&root, f64::INFINITY, &mut by_roots);
+                    walker.visit(&root, f64::INFINITY, f64::INFINITY, &mut by_roots);
                 }
                 let starts = walker.starts(system.roots(), 64);
                 most = most.max(starts.len());
                 for start in &starts {
-                    walker.visit(start, f64::INFINITY, &mut by_starts);
+                    walker.visit(start, f64::INFINITY, f64::INFINITY, &mut by_starts);
                 }
                 assert!(!by_roots.is_empty());
                 assert_eq!(by_roots, by_starts, "magnitude {magnitude}");

@@ -122,6 +122,26 @@ pub trait TileSystem: Sync {
     }
     /// The region a density bounds itself over.
     fn region(&self, tile: &Self::Tile) -> Self::Region;
+    /// The region whose density bound picks the importance bin a terminal
+    /// tile's sample is placed for, where it is tighter than
+    /// [`TileSystem::region`]: the tile's own cells, while the region must
+    /// also hold the samples that land past them. A tighter bound fits the
+    /// bin to the share of its set that is kept (see the [`crate::engine`]
+    /// module doc, Two bounds). `None` (the default): the region's bound
+    /// picks it.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let tile = sphere.roots()[5];
+    /// let placing = sphere.placing_region(&tile).unwrap();
+    /// assert!(placing.radius < sphere.region(&tile).radius);
+    /// ```
+    fn placing_region(&self, tile: &Self::Tile) -> Option<Self::Region> {
+        let _ = tile;
+        None
+    }
     /// The tile of `level` whose code is `code`, when the system can find it
     /// directly (base-A codes can: their digits spell the path from the
     /// root). Lets uniform requests stream in code order with no recursion,

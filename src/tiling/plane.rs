@@ -504,6 +504,27 @@ impl PlaneTiling {
             orientation: step.orientation,
         }
     }
+
+    /// The tile's region with the box `[lo, hi]` (the tile's frame, cells).
+    fn region_boxed(&self, tile: &PlaneTile, [lo, hi]: [DVec2; 2]) -> PlaneRegion {
+        let s = self.inv_size[tile.level as usize];
+        let (x, y) = tile.placement.origin;
+        let origin = DVec2::new(x as f64, y as f64);
+        let frame = &self.frames[tile.placement.orientation.index()];
+        let mut cells = [DVec2::ZERO; MAX_CELLS];
+        for (cell, &centre) in cells.iter_mut().zip(&frame.centres) {
+            *cell = (origin + centre) * s;
+        }
+        let (lo, hi) = mirrored_box((origin + lo) * s, (origin + hi) * s);
+        PlaneRegion {
+            lo,
+            hi,
+            cell: s,
+            cells,
+            count: frame.count,
+            centroid: (origin + frame.centroid) * s,
+        }
+    }
 }
 
 impl Subdivision for PlaneTiling {
@@ -590,25 +611,13 @@ impl TileSystem for PlaneTiling {
     // off such ramp requests in interleaved scratch runs
     #[inline(always)]
     fn region(&self, tile: &PlaneTile) -> PlaneRegion {
-        let s = self.inv_size[tile.level as usize];
-        let (x, y) = tile.placement.origin;
-        let origin = DVec2::new(x as f64, y as f64);
         let orientation = tile.placement.orientation.index();
-        let frame = &self.frames[orientation];
-        let [lo, hi] = self.boxes[tile.class as usize * 8 + orientation];
-        let mut cells = [DVec2::ZERO; MAX_CELLS];
-        for (cell, &centre) in cells.iter_mut().zip(&frame.centres) {
-            *cell = (origin + centre) * s;
-        }
-        let (lo, hi) = mirrored_box((origin + lo) * s, (origin + hi) * s);
-        PlaneRegion {
-            lo,
-            hi,
-            cell: s,
-            cells,
-            count: frame.count,
-            centroid: (origin + frame.centroid) * s,
-        }
+        self.region_boxed(tile, self.boxes[tile.class as usize * 8 + orientation])
+    }
+
+    fn placing_region(&self, tile: &PlaneTile) -> Option<PlaneRegion> {
+        let frame = &self.frames[tile.placement.orientation.index()];
+        Some(self.region_boxed(tile, [frame.lo, frame.hi]))
     }
 
     fn map_code_order<T: Send>(

@@ -447,6 +447,26 @@ impl SphereTiling {
             .collect()
     }
 
+    /// The tile's region, its cap and spill holding what `reach` reaches.
+    fn region_reaching(&self, tile: &SphereTile, reach: SampleReach) -> SphereRegion {
+        let cell = |i: usize| {
+            let (cx, cy) = self.shape.cells()[i];
+            let p = self.face_point(tile, [cx as f64 + 0.5, cy as f64 + 0.5]);
+            [p.x, p.y]
+        };
+        let nside = Self::nside(tile.level as u32) as f64;
+        SphereRegion {
+            centroid: self.face_point(tile, self.centroid),
+            // face points clamp onto the face, which only brings them
+            // nearer the centroid and the cells
+            radius: FACE_LIPSCHITZ * reach.from_centroid / nside + reach.warp,
+            face: tile.face,
+            cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
+            spill: reach.past_cells / nside,
+            warp: reach.warp,
+        }
+    }
+
     /// How far a level's own samples land: its offsets in every bin, its
     /// sibling fills and drop moves, and its zonal warps.
     fn own_reach(&self, level: usize) -> SampleReach {
@@ -696,24 +716,16 @@ impl TileSystem for SphereTiling {
     }
 
     fn region(&self, tile: &SphereTile) -> SphereRegion {
-        let centroid = self.centroid;
-        let cell = |i: usize| {
-            let (cx, cy) = self.shape.cells()[i];
-            let p = self.face_point(tile, [cx as f64 + 0.5, cy as f64 + 0.5]);
-            [p.x, p.y]
+        self.region_reaching(tile, self.sample_reach(tile.level as u32))
+    }
+
+    fn placing_region(&self, tile: &SphereTile) -> Option<SphereRegion> {
+        let pentomino = SampleReach {
+            from_centroid: PENTOMINO_RADIUS,
+            past_cells: 0.0,
+            warp: 0.0,
         };
-        let nside = Self::nside(tile.level as u32) as f64;
-        let reach = self.sample_reach(tile.level as u32);
-        SphereRegion {
-            centroid: self.face_point(tile, centroid),
-            // face points clamp onto the face, which only brings them
-            // nearer the centroid and the cells
-            radius: FACE_LIPSCHITZ * reach.from_centroid / nside + reach.warp,
-            face: tile.face,
-            cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
-            spill: reach.past_cells / nside,
-            warp: reach.warp,
-        }
+        Some(self.region_reaching(tile, pentomino))
     }
 
     fn map_code_order<T: Send>(
