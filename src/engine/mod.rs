@@ -5,7 +5,7 @@
 //!     if capacity(level) >= b:                     terminal, its own bounds unneeded
 //!         if code(tile) >= b: return               (rejected unseen)
 //!     else b = magnitude * bound(region(tile)) / mean;  terminal if capacity(level) >= b
-//!          q = min(b, magnitude * bound(placing_region(tile)) / mean)  (when needed)
+//!          q = magnitude * bound(placing_region(tile)) / mean, if at least b / 2, else b
 //!     if terminal:
 //!         constant density d: keep if code(tile) + 1/2 < d, at sample(tile, d / capacity(level))
 //!         else (thinning): t = code(tile) + u, u a seeded dither in [0, 1)
@@ -19,13 +19,18 @@
 //! children's (which it thins when it makes them terminal), and those land
 //! up to a few cells past the tile ([`TileSystem::region`]). `b` decides
 //! the level and which codes are candidates, and must be at least the
-//! density wherever they land. The bin a candidate is placed for is
-//! picked by `q`, the bound over the tile's own cells
-//! ([`TileSystem::placing_region`]): nearer the density, so that the bin
-//! fits the share of its set that is kept. Placed for `b`, smooth
-//! densities lost spacing (SPHERE_ADAPTIVE's cells under 0.85: 54 of a
-//! bump's 56, 32 of 80 for caps, a polygon and maps; placed for `q`, 46
-//! and 26). Both are functions of the tile alone, so what follows holds.
+//! density wherever they land. Where the density is smooth, the bin a
+//! candidate is placed for is picked by `q`, the bound over the tile's
+//! own cells ([`TileSystem::placing_region`]): nearer the density, so
+//! that the bin fits the share of its set that is kept. Placed for `b`,
+//! smooth densities lost spacing (SPHERE_ADAPTIVE's cells under 0.85: 54
+//! of a bump's 56, 32 of 80 for caps, a polygon and maps; placed for `q`,
+//! 46 and 26). Beside a step of more than 2x (`q < b / 2`) the candidate
+//! is placed for `b`: placed for `q` there, the tile's bin changed where
+//! its cells met the edge and its level where its region did, and the
+//! local bias beside hard edges grew (EDGE_BIAS.md's rim rings, |z| 12.9
+//! -> 17.6; 46 and 28 cells under 0.85 with the rule). Both are functions
+//! of the tile alone, so what follows holds.
 //!
 //! **Why the expectation is exact.** Under a uniformly random rotation of
 //! the density (a random toroidal shift on the plane), the tile of a given

@@ -135,6 +135,10 @@ pub(super) const MAX_SHARE_HINT: f64 = (1 << 20) as f64;
 /// before the request fails ([`Walker::excess`]): rounding only. The
 /// shipped densities never exceed theirs.
 pub(super) const BOUND_TOLERANCE: f64 = 1e-9;
+/// The least share of its bound a tile's placing bound may be and still
+/// pick its bin ([`Walker::placing_bound`]): below it the tile lies beside
+/// a step, where placing for the bound keeps the local bias smaller.
+const PLACING_SHARE: f64 = 0.5;
 pub(super) struct Walker<'a, S: TileSystem, D: ?Sized> {
     system: &'a S,
     density: &'a D,
@@ -402,17 +406,22 @@ where
         self.visit_children(tile, level, bound, placing, out);
     }
 
-    /// The scaled bound over the tile's placing region
-    /// ([`TileSystem::placing_region`]), at most its bound `bound`: what
-    /// picks the bin its sample, or its children's when it makes them
-    /// terminal, is placed for (see the module doc, Two bounds).
+    /// What picks the bin the tile's sample, or its children's when it
+    /// makes them terminal, is placed for: the scaled bound over its
+    /// placing region ([`TileSystem::placing_region`]) where that is at
+    /// least [`PLACING_SHARE`] of its bound `bound` (a smooth density), else
+    /// `bound` (beside a step); see the module doc, Two bounds.
     fn placing_bound(&self, tile: &S::Tile, bound: f64) -> f64 {
         if self.constant.is_some() {
             return bound;
         }
-        match self.system.placing_region(tile) {
-            Some(region) => self.scaled(self.density.bound(&region)).min(bound),
-            None => bound,
+        let Some(region) = self.system.placing_region(tile) else {
+            return bound;
+        };
+        let placing = self.scaled(self.density.bound(&region));
+        match placing >= PLACING_SHARE * bound {
+            true => placing.min(bound),
+            false => bound,
         }
     }
 
