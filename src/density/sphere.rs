@@ -314,9 +314,10 @@ fn clean(v: f64) -> f64 {
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
         // every sample the bound covers lies within `cell_reach` of one of
-        // the tile's five cell centres, nearer than the cap's centre
-        // reaches: from their largest value the bound grows less (a bare
-        // cap is known only by its centre)
+        // the tile's five cell centres; where that is less than the cap's
+        // radius (past level 2), the bound grows less from their largest
+        // value than from the centre's (a bare cap is known only by its
+        // centre)
         let reach = region.cell_reach();
         let (value, least, distance) = if reach < region.radius {
             let values = region.probes().map(|p| clean((self.f)(p)));

@@ -29,8 +29,12 @@
 //! is placed for `b`: placed for `q` there, the tile's bin changed where
 //! its cells met the edge and its level where its region did, and the
 //! local bias beside hard edges grew (EDGE_BIAS.md's rim rings, |z| 12.9
-//! -> 17.6; 46 and 28 cells under 0.85 with the rule). Both are functions
-//! of the tile alone, so what follows holds.
+//! -> 17.6; 46 and 28 cells under 0.85 with the rule). `q` is a function
+//! of the tile, and where it picks the bin the density varies by less
+//! than 2x over the region: the candidate's place follows the density no
+//! more than when the bound over the tile's cells was its only bound (up
+//! to session 52), which is what the argument below needs, within the
+//! local bias beside edges that EDGE_BIAS.md measures.
 //!
 //! **Why the expectation is exact.** Under a uniformly random rotation of
 //! the density (a random toroidal shift on the plane), the tile of a given
@@ -151,6 +155,11 @@ pub type Window<'a, R> = dyn Fn(&R) -> bool + Sync + 'a;
 /// assert_eq!(near.iter().filter(inside).count(), all.iter().filter(inside).count());
 /// assert!(near.len() < all.len() / 100);
 /// ```
+///
+/// # Errors
+/// Where a sample lands on a density above its tile's bound (see
+/// [`Density::bound`]); only the tiles reaching the window are seen, so a
+/// window can succeed where the whole request fails.
 pub fn collect_within<S, D>(
     system: &S,
     density: &D,
@@ -487,7 +496,7 @@ where
 /// where a sample landed (see `Walker::excess`).
 fn bound_exceeded(ratio: f64) -> Error {
     Error::Density(
-        "bound".into(),
+        "Density::bound".into(),
         format!(
             "the density where a sample landed is {ratio:.6} times its bound over the sample's tile; \
              Density::bound must never be below the density, or the samples are biased \

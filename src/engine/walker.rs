@@ -460,8 +460,9 @@ where
         (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
-    /// Places the sample of a terminal tile of code `code` and scaled bound
-    /// `bound` (code units), if its code is kept (see the module doc).
+    /// Places the sample of a terminal tile of code `code`, scaled bound
+    /// `bound` and placing bound `placing` (code units; see
+    /// [`Walker::placing_bound`]), if its code is kept (see the module doc).
     #[inline(always)]
     fn emit(
         &self,
@@ -494,7 +495,8 @@ where
             }
             return;
         }
-        // thinning: placed for the bound, kept by the density it lands on
+        // thinning: placed for the placing bound, kept by the density it
+        // lands on if the bound allows
         let threshold = code + self.dither(code, level);
         if threshold >= bound {
             return;
@@ -515,7 +517,8 @@ where
         }
     }
 
-    /// Visits the children of a tile whose scaled bound is `bound`.
+    /// Visits the children of a tile whose scaled bound is `bound`; those it
+    /// makes terminal are placed for `placing`.
     fn visit_children(
         &self,
         tile: &S::Tile,

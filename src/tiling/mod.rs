@@ -124,7 +124,7 @@ pub trait TileSystem: Sync {
     fn region(&self, tile: &Self::Tile) -> Self::Region;
     /// The region whose density bound picks the importance bin a terminal
     /// tile's sample is placed for, where it is tighter than
-    /// [`TileSystem::region`]: the tile's own cells, while the region must
+    /// [`TileSystem::region`]: the tile's own cells (or their box), while the region must
     /// also hold the samples that land past them. A tighter bound fits the
     /// bin to the share of its set that is kept (see the [`crate::engine`]
     /// module doc, Two bounds). `None` (the default): the region's bound
