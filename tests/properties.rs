@@ -83,8 +83,8 @@ impl<T: TileSystem, F: Fn(&T, &T::Tile, T::Point, f64) -> bool + Sync> TileSyste
     fn region(&self, tile: &T::Tile) -> T::Region {
         self.inner.region(tile)
     }
-    fn placing_region(&self, tile: &T::Tile) -> Option<T::Region> {
-        self.inner.placing_region(tile)
+    fn placing_region(&self, tile: &T::Tile, region: &T::Region) -> Option<T::Region> {
+        self.inner.placing_region(tile, region)
     }
     fn carries_sample(&self, tile: &T::Tile) -> bool {
         self.inner.carries_sample(tile)

@@ -736,6 +736,57 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    /// `Density::bounds`, which the engine calls where it needs a tile's
+    /// bound and its placing bound together, gives exactly the two bounds
+    /// apart, for every density that computes them in one pass.
+    #[test]
+    fn joint_bounds_are_the_bounds_apart(
+        level in 0u32..9,
+        pick in 0usize..usize::MAX,
+        seed in 0u64..1000,
+    ) {
+        use tessera::density::envmap::{EnvMap, Up};
+        use tessera::density::region::Regions;
+        use tessera::density::sphere::Rotated;
+        use tessera::density::Density;
+        use tessera::io::image::Raster;
+        use tessera::tiling::sphere::SphereRegion;
+        fn check(d: &dyn Density<SphereRegion>, region: &SphereRegion, inner: &SphereRegion) {
+            assert_eq!(d.bounds(region, inner), (d.bound(region), d.bound(inner)));
+        }
+        let tiling = SphereTiling::default();
+        let tile = tiling
+            .tile_with_code(level, (pick % (240 << (2 * level))) as u128)
+            .unwrap();
+        let region = tiling.region(&tile);
+        let inner = tiling.placing_region(&tile, &region).unwrap();
+        // a map with a bright spot and texture, plain and turned
+        let (width, height) = (96, 48);
+        let values = (0..width * height)
+            .map(|k| {
+                let (i, j) = (k % width, k / width);
+                1.0 + ((i * 7 + j * 13) % 5) as f64 + if (i, j) == (30, 9) { 1e4 } else { 0.0 }
+            })
+            .collect();
+        let raster = Raster { width, height, values, bad_pixels: 0 };
+        let map = EnvMap::new(raster, Up::Z).unwrap();
+        check(&map, &region, &inner);
+        check(&map.with_seed(seed), &region, &inner);
+        check(&EnvMap::new(Raster { width: 1, height: 1, values: vec![2.0], bad_pixels: 0 }, Up::Y).unwrap(), &region, &inner);
+        let lobe = |v: DVec3| (40.0 * (v.z - 1.0)).exp();
+        let plain = SphereFn::new(lobe, 40.0).unwrap();
+        check(&plain, &region, &inner);
+        let relative = SphereFn::new(lobe, 40.0).unwrap().with_relative_lipschitz(40.0).unwrap();
+        check(&relative, &region, &inner);
+        check(&Rotated::new(SphereFn::new(lobe, 40.0).unwrap(), seed), &region, &inner);
+        let regions = Regions::parse(&["cap:20,40,25,16", "polygon:-10 35,40 30,55 55,20 72,-15 62;4"]).unwrap();
+        check(&regions, &region, &inner);
+        check(&Rotated::new(regions, seed), &region, &inner);
+    }
+}
+
+proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
     #[test]
     fn random_caps_follow_their_density(

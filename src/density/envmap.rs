@@ -575,7 +575,13 @@ impl EnvMap {
     /// every pixel a tile's bounding cap touches; a cap holding a pole
     /// touches every column.
     fn touched(&self, region: &SphereRegion) -> (usize, usize, usize, usize) {
-        let px = &*self.pixels;
+        self.touched_about(self.centre_of(region), region.radius)
+    }
+
+    /// A region's centre in the map's frame: `(sin theta, phi, theta)`,
+    /// `theta` and `phi` within [`FAST_ATAN2_ERROR`].
+    #[inline(always)]
+    fn centre_of(&self, region: &SphereRegion) -> (f64, f64, f64) {
         let (z, rxy, phi) = if self.plain {
             // straight from face coordinates: no trigonometry
             region.centroid.z_sin_phi()
@@ -585,10 +591,20 @@ impl EnvMap {
             let phi = if phi < 0.0 { phi + TAU } else { phi };
             (m.z, (m.x * m.x + m.y * m.y).sqrt(), phi)
         };
-        let theta = fast_atan2(rxy, z);
+        (rxy, phi, fast_atan2(rxy, z))
+    }
+
+    /// [`EnvMap::touched`] of the cap of `radius` about `centre` (see
+    /// [`EnvMap::centre_of`]).
+    fn touched_about(
+        &self,
+        (rxy, phi, theta): (f64, f64, f64),
+        radius: f64,
+    ) -> (usize, usize, usize, usize) {
+        let px = &*self.pixels;
         // wider than the cap by the angles' error, so pixel edges never
         // round inwards
-        let r = region.radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
+        let r = radius * (1.0 + 1e-9) + 2.0 * FAST_ATAN2_ERROR;
         let (rows_per_rad, cols_per_rad) = (px.rows_per_rad, px.cols_per_rad);
         let j1 = (((theta + r) * rows_per_rad) as usize).min(px.height - 1);
         let j0 = (((theta - r).max(0.0) * rows_per_rad) as usize).min(j1);
@@ -652,8 +668,14 @@ impl EnvMap {
     /// The maximum over the pixels a region touches, and the pixel's value
     /// when it touches only one (then the region's exact average).
     fn bound_in(&self, region: &SphereRegion) -> (f64, Option<f64>) {
+        self.max_touched(self.touched(region))
+    }
+
+    /// The maximum over the pixels of a [`EnvMap::touched`] range, and the
+    /// pixel's value when it is one pixel.
+    fn max_touched(&self, touched: (usize, usize, usize, usize)) -> (f64, Option<f64>) {
         let px = &*self.pixels;
-        match self.touched(region) {
+        match touched {
             (j0, j1, c0, c1) if j0 == j1 && c0 == c1 => {
                 let v = px.values[j0 * px.width + c0];
                 (v, Some(v))
@@ -702,6 +724,16 @@ impl EnvMap {
 impl Density<SphereRegion> for EnvMap {
     fn bound(&self, region: &SphereRegion) -> f64 {
         self.bound_in(region).0
+    }
+
+    fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
+        if region.centroid != inner.centroid {
+            return (self.bound(region), self.bound(inner));
+        }
+        // one centre, two radii
+        let centre = self.centre_of(region);
+        let of = |radius| self.max_touched(self.touched_about(centre, radius)).0;
+        (of(region.radius), of(inner.radius))
     }
 
     fn average(&self, region: &SphereRegion) -> f64 {

@@ -44,6 +44,27 @@ pub trait Density<R: Region>: Sync {
     /// truth: a request fails with an error where a sample lands on a
     /// density above its tile's bound, as its samples would be biased).
     fn bound(&self, region: &R) -> f64;
+    /// [`Density::bound`] over `region` and over `inner`, a region inside it
+    /// about the same centre (a tile's placing region,
+    /// [`crate::tiling::TileSystem::placing_region`]), in one call: the
+    /// engine asks for both where it knows it needs both, and a density
+    /// whose bound starts from the region's centre or probes computes
+    /// them once.
+    ///
+    /// # Example
+    /// ```
+    /// use tessera::density::{sphere::SphereFn, Density};
+    /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
+    /// let sphere = SphereTiling::default();
+    /// let tile = sphere.child(&sphere.roots()[4], 0);
+    /// let region = sphere.region(&tile);
+    /// let inner = sphere.placing_region(&tile, &region).unwrap();
+    /// let d = SphereFn::new(|v: glam::DVec3| 2.0 + v.z, 1.0).unwrap();
+    /// assert_eq!(d.bounds(&region, &inner), (d.bound(&region), d.bound(&inner)));
+    /// ```
+    fn bounds(&self, region: &R, inner: &R) -> (f64, f64) {
+        (self.bound(region), self.bound(inner))
+    }
     /// The density's average over the region (may be approximate).
     fn average(&self, region: &R) -> f64;
     /// The density at a point: where a tile's sample lands it keeps or
@@ -97,6 +118,9 @@ impl<R: Region> Density<R> for Uniform {
 impl<R: Region, D: Density<R> + ?Sized> Density<R> for &D {
     fn bound(&self, region: &R) -> f64 {
         (**self).bound(region)
+    }
+    fn bounds(&self, region: &R, inner: &R) -> (f64, f64) {
+        (**self).bounds(region, inner)
     }
     fn average(&self, region: &R) -> f64 {
         (**self).average(region)

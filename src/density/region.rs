@@ -112,19 +112,24 @@ impl Shape {
     }
 
     fn side(&self, region: &SphereRegion) -> Side {
+        self.side_of(region.center(), region.radius)
+    }
+
+    /// Where the cap of `radius` about `center` lies.
+    fn side_of(&self, center: DVec3, radius: f64) -> Side {
         match self {
             Shape::Cap(c, r) => {
-                let d = angle_between(*c, region.center());
-                if d + region.radius <= *r {
+                let d = angle_between(*c, center);
+                if d + radius <= *r {
                     Side::Inside
-                } else if d - region.radius > *r {
+                } else if d - radius > *r {
                     Side::Outside
                 } else {
                     Side::Unknown
                 }
             }
             Shape::Polygon(vertices, pbox) => {
-                let Some(tile) = cap_box(region.center(), region.radius) else {
+                let Some(tile) = cap_box(center, radius) else {
                     return Side::Unknown;
                 };
                 let shifted = |k: f64| [tile[0] + k, tile[1], tile[2] + k, tile[3]];
@@ -139,7 +144,7 @@ impl Shape {
                 let crossed = boxes.iter().filter(|b| overlaps(b)).any(|b| {
                     (0..n).any(|k| segment_meets_box(vertices[k], vertices[(k + 1) % n], *b))
                 });
-                match (crossed, self.contains(region.center())) {
+                match (crossed, self.contains(center)) {
                     (true, _) => Side::Unknown,
                     (false, true) => Side::Inside,
                     (false, false) => Side::Outside,
@@ -264,6 +269,27 @@ impl Regions {
         super::sphere::cell_centre_mean(128, |v| self.at(v))
     }
 
+    /// The bound over the cap of `radius` about `center`.
+    fn bound_about(&self, center: DVec3, radius: f64) -> f64 {
+        let mut bound: f64 = 0.0;
+        let mut covered = false;
+        for (shape, contrast) in &self.shapes {
+            match shape.side_of(center, radius) {
+                Side::Inside => {
+                    covered = true;
+                    bound = bound.max(*contrast);
+                }
+                Side::Unknown => bound = bound.max(*contrast),
+                Side::Outside => {}
+            }
+        }
+        if covered {
+            bound
+        } else {
+            bound.max(1.0)
+        }
+    }
+
     fn at(&self, v: DVec3) -> f64 {
         self.shapes
             .iter()
@@ -284,23 +310,17 @@ fn check_contrast(contrast: f64) -> Result<(), String> {
 
 impl Density<SphereRegion> for Regions {
     fn bound(&self, region: &SphereRegion) -> f64 {
-        let mut bound: f64 = 0.0;
-        let mut covered = false;
-        for (shape, contrast) in &self.shapes {
-            match shape.side(region) {
-                Side::Inside => {
-                    covered = true;
-                    bound = bound.max(*contrast);
-                }
-                Side::Unknown => bound = bound.max(*contrast),
-                Side::Outside => {}
-            }
+        self.bound_about(region.center(), region.radius)
+    }
+
+    fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
+        if region.centroid != inner.centroid {
+            return (self.bound(region), self.bound(inner));
         }
-        if covered {
-            bound
-        } else {
-            bound.max(1.0)
-        }
+        // one centre, two radii
+        let center = region.center();
+        let of = |radius| self.bound_about(center, radius);
+        (of(region.radius), of(inner.radius))
     }
 
     fn average(&self, region: &SphereRegion) -> f64 {

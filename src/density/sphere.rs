@@ -311,6 +311,26 @@ fn clean(v: f64) -> f64 {
     }
 }
 
+impl<F: Fn(DVec3) -> f64 + Sync> SphereFn<F> {
+    /// The largest and least value at a region's five cell centres.
+    fn probed(&self, region: &SphereRegion) -> (f64, f64) {
+        let values = region.probes().map(|p| clean((self.f)(p)));
+        let most = values.iter().copied().fold(0.0, f64::max);
+        (most, values.iter().copied().fold(f64::INFINITY, f64::min))
+    }
+
+    /// The bound `distance` from points whose largest and least values are
+    /// `(value, least)`.
+    fn grown(&self, (value, least): (f64, f64), distance: f64) -> f64 {
+        let additive = value + self.lipschitz * distance;
+        match self.relative_lipschitz {
+            // f <= f(p) e^(k d) at distance d from p, where no probe is 0
+            Some(k) if least > 0.0 => additive.min(value * (k * distance).exp()),
+            _ => additive,
+        }
+    }
+}
+
 impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
     fn bound(&self, region: &SphereRegion) -> f64 {
         // every sample the bound covers lies within `cell_reach` of one of
@@ -319,24 +339,22 @@ impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
         // value than from the centre's (a bare cap is known only by its
         // centre)
         let reach = region.cell_reach();
-        let (value, least, distance) = if reach < region.radius {
-            let values = region.probes().map(|p| clean((self.f)(p)));
-            let most = values.iter().copied().fold(0.0, f64::max);
-            (
-                most,
-                values.iter().copied().fold(f64::INFINITY, f64::min),
-                reach,
-            )
+        if reach < region.radius {
+            self.grown(self.probed(region), reach)
         } else {
             let centre = clean((self.f)(region.center()));
-            (centre, centre, region.radius)
-        };
-        let additive = value + self.lipschitz * distance;
-        match self.relative_lipschitz {
-            // f <= f(p) e^(k d) at distance d from p, where no probe is 0
-            Some(k) if least > 0.0 => additive.min(value * (k * distance).exp()),
-            _ => additive,
+            self.grown((centre, centre), region.radius)
         }
+    }
+
+    fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
+        let (reach, inner_reach) = (region.cell_reach(), inner.cell_reach());
+        if reach >= region.radius || inner_reach >= inner.radius || region.cells != inner.cells {
+            return (self.bound(region), self.bound(inner));
+        }
+        // the same five probes
+        let probed = self.probed(region);
+        (self.grown(probed, reach), self.grown(probed, inner_reach))
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let probes = region.probes();
@@ -485,6 +503,18 @@ impl<D> Rotated<D> {
 impl<D: Density<SphereRegion>> Density<SphereRegion> for Rotated<D> {
     fn bound(&self, region: &SphereRegion) -> f64 {
         self.inner.bound(&self.cap_of(region))
+    }
+    fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
+        if region.centroid != inner.centroid {
+            return (self.bound(region), self.bound(inner));
+        }
+        // one centre to turn
+        let cap = self.cap_of(region);
+        let inner_cap = SphereRegion {
+            radius: inner.radius,
+            ..cap
+        };
+        self.inner.bounds(&cap, &inner_cap)
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let probes = region.probes();

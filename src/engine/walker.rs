@@ -307,6 +307,30 @@ where
         bound > 0.0 && self.capacities[level as usize + 1] < bound
     }
 
+    /// A tile's own scaled bound, with the scaled bound over its placing
+    /// region when that is sure to be needed (the parent's bound
+    /// `parent_bound` makes the tile's children terminal, so the tile or
+    /// they are placed; [`Walker::placing_bound`]): one call of
+    /// [`Density::bounds`] shares the work of the two.
+    #[inline(always)]
+    fn own_bounds(
+        &self,
+        tile: &S::Tile,
+        level: u32,
+        parent_bound: f64,
+        region: Option<&S::Region>,
+    ) -> (f64, Option<f64>) {
+        if let (None, Some(region)) = (self.constant, region) {
+            if self.capacities[level as usize + 1] >= parent_bound {
+                if let Some(placing) = self.system.placing_region(tile, region) {
+                    let (bound, placing) = self.density.bounds(region, &placing);
+                    return (self.scaled(bound), Some(self.scaled(placing)));
+                }
+            }
+        }
+        (self.own_bound(region), None)
+    }
+
     /// A tile's own scaled bound; `region` may be `None` only for a
     /// constant density.
     #[inline(always)]
@@ -378,9 +402,9 @@ where
         region: Option<&S::Region>,
         out: &mut Vec<Sample<S::Point>>,
     ) {
-        let bound = match capacity >= parent_bound {
-            true => parent_bound,
-            false => self.own_bound(region),
+        let (bound, known_placing) = match capacity >= parent_bound {
+            true => (parent_bound, None),
+            false => self.own_bounds(tile, level, parent_bound, region),
         };
         if bound.is_nan() || bound <= 0.0 {
             return; // nothing to place here (zero density)
@@ -393,15 +417,16 @@ where
             if code + self.least_dither >= bound {
                 return; // not even the bound would keep it
             }
-            let placing = match capacity >= parent_bound {
-                true => parent_placing,
-                false => self.placing_bound(tile, bound),
+            let placing = match (capacity >= parent_bound, region) {
+                (true, _) => parent_placing,
+                (false, Some(region)) => self.placing_bound(tile, region, bound, known_placing),
+                (false, None) => bound, // a constant density
             };
             return self.emit(tile, level, code, bound, placing, out);
         }
-        let placing = match self.capacities[level as usize + 1] >= bound {
-            true => self.placing_bound(tile, bound),
-            false => bound,
+        let placing = match (self.capacities[level as usize + 1] >= bound, region) {
+            (true, Some(region)) => self.placing_bound(tile, region, bound, known_placing),
+            _ => bound,
         };
         self.visit_children(tile, level, bound, placing, out);
     }
@@ -410,15 +435,26 @@ where
     /// makes them terminal, is placed for: the scaled bound over its
     /// placing region ([`TileSystem::placing_region`]) where that is at
     /// least [`PLACING_SHARE`] of its bound `bound` (a smooth density), else
-    /// `bound` (beside a step); see the module doc, Two bounds.
-    fn placing_bound(&self, tile: &S::Tile, bound: f64) -> f64 {
+    /// `bound` (beside a step); see the module doc, Two bounds. `region`:
+    /// the tile's region; `known`: the scaled bound over its placing region,
+    /// if [`Walker::own_bounds`] computed it.
+    fn placing_bound(
+        &self,
+        tile: &S::Tile,
+        region: &S::Region,
+        bound: f64,
+        known: Option<f64>,
+    ) -> f64 {
         if self.constant.is_some() {
             return bound;
         }
-        let Some(region) = self.system.placing_region(tile) else {
-            return bound;
+        let placing = match known {
+            Some(placing) => placing,
+            None => match self.system.placing_region(tile, region) {
+                Some(placing) => self.scaled(self.density.bound(&placing)),
+                None => return bound,
+            },
         };
-        let placing = self.scaled(self.density.bound(&region));
         match placing >= PLACING_SHARE * bound {
             true => placing.min(bound),
             false => bound,

@@ -127,7 +127,9 @@ pub trait TileSystem: Sync {
     /// [`TileSystem::region`]: the tile's own cells (or their box), while the region must
     /// also hold the samples that land past them. A tighter bound fits the
     /// bin to the share of its set that is kept (see the [`crate::engine`]
-    /// module doc, Two bounds). `None` (the default): the region's bound
+    /// module doc, Two bounds). `region` is the tile's
+    /// [`TileSystem::region`], which the engine has already built: the two
+    /// share most of their fields. `None` (the default): the region's bound
     /// picks it.
     ///
     /// # Example
@@ -135,11 +137,12 @@ pub trait TileSystem: Sync {
     /// use tessera::tiling::{sphere::SphereTiling, TileSystem};
     /// let sphere = SphereTiling::default();
     /// let tile = sphere.roots()[5];
-    /// let placing = sphere.placing_region(&tile).unwrap();
-    /// assert!(placing.radius < sphere.region(&tile).radius);
+    /// let region = sphere.region(&tile);
+    /// let placing = sphere.placing_region(&tile, &region).unwrap();
+    /// assert!(placing.radius < region.radius);
     /// ```
-    fn placing_region(&self, tile: &Self::Tile) -> Option<Self::Region> {
-        let _ = tile;
+    fn placing_region(&self, tile: &Self::Tile, region: &Self::Region) -> Option<Self::Region> {
+        let _ = (tile, region);
         None
     }
     /// The tile of `level` whose code is `code`, when the system can find it

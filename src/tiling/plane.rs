@@ -505,8 +505,17 @@ impl PlaneTiling {
         }
     }
 
-    /// The tile's region with the box `[lo, hi]` (the tile's frame, cells).
-    fn region_boxed(&self, tile: &PlaneTile, [lo, hi]: [DVec2; 2]) -> PlaneRegion {
+    /// The box `[lo, hi]` (the tile's frame, cells) in the unit square.
+    #[inline(always)]
+    fn cells_box(&self, tile: &PlaneTile, [lo, hi]: [DVec2; 2]) -> (DVec2, DVec2) {
+        let s = self.inv_size[tile.level as usize];
+        let (x, y) = tile.placement.origin;
+        let origin = DVec2::new(x as f64, y as f64);
+        mirrored_box((origin + lo) * s, (origin + hi) * s)
+    }
+
+    /// The tile's region with the box `boxed` (the tile's frame, cells).
+    fn region_boxed(&self, tile: &PlaneTile, boxed: [DVec2; 2]) -> PlaneRegion {
         let s = self.inv_size[tile.level as usize];
         let (x, y) = tile.placement.origin;
         let origin = DVec2::new(x as f64, y as f64);
@@ -515,7 +524,7 @@ impl PlaneTiling {
         for (cell, &centre) in cells.iter_mut().zip(&frame.centres) {
             *cell = (origin + centre) * s;
         }
-        let (lo, hi) = mirrored_box((origin + lo) * s, (origin + hi) * s);
+        let (lo, hi) = self.cells_box(tile, boxed);
         PlaneRegion {
             lo,
             hi,
@@ -615,9 +624,11 @@ impl TileSystem for PlaneTiling {
         self.region_boxed(tile, self.boxes[tile.class as usize * 8 + orientation])
     }
 
-    fn placing_region(&self, tile: &PlaneTile) -> Option<PlaneRegion> {
+    fn placing_region(&self, tile: &PlaneTile, region: &PlaneRegion) -> Option<PlaneRegion> {
+        // the region's cells, in the box of the cells alone
         let frame = &self.frames[tile.placement.orientation.index()];
-        Some(self.region_boxed(tile, [frame.lo, frame.hi]))
+        let (lo, hi) = self.cells_box(tile, [frame.lo, frame.hi]);
+        Some(PlaneRegion { lo, hi, ..*region })
     }
 
     fn map_code_order<T: Send>(

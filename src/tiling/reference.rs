@@ -81,8 +81,8 @@ impl<S: ReferencePoint> TileSystem for WithoutOffsets<S> {
     fn region(&self, tile: &S::Tile) -> S::Region {
         self.0.region(tile)
     }
-    fn placing_region(&self, tile: &S::Tile) -> Option<S::Region> {
-        self.0.placing_region(tile)
+    fn placing_region(&self, tile: &S::Tile, region: &S::Region) -> Option<S::Region> {
+        self.0.placing_region(tile, region)
     }
     fn tile_with_code(&self, level: u32, code: Code) -> Option<S::Tile> {
         self.0.tile_with_code(level, code)

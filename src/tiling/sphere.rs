@@ -719,13 +719,15 @@ impl TileSystem for SphereTiling {
         self.region_reaching(tile, self.sample_reach(tile.level as u32))
     }
 
-    fn placing_region(&self, tile: &SphereTile) -> Option<SphereRegion> {
-        let pentomino = SampleReach {
-            from_centroid: PENTOMINO_RADIUS,
-            past_cells: 0.0,
+    fn placing_region(&self, tile: &SphereTile, region: &SphereRegion) -> Option<SphereRegion> {
+        // the region's centroid and cells, with the pentomino's reach
+        let nside = Self::nside(tile.level as u32) as f64;
+        Some(SphereRegion {
+            radius: FACE_LIPSCHITZ * PENTOMINO_RADIUS / nside,
+            spill: 0.0,
             warp: 0.0,
-        };
-        Some(self.region_reaching(tile, pentomino))
+            ..*region
+        })
     }
 
     fn map_code_order<T: Send>(
