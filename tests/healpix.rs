@@ -849,3 +849,60 @@ fn total_area_by_cells() {
         assert_relative_eq!(a, expected, max_relative = 1e-3);
     }
 }
+
+/// The operator norm of the face-to-sphere map's Jacobian at a face point,
+/// by central differences.
+fn stretch_at(face: u8, x: f64, y: f64) -> f64 {
+    let h = 1e-7;
+    let at = |x: f64, y: f64| FacePoint::new(face, x, y).to_vec();
+    let dx = (at(x + h, y) - at(x - h, y)) / (2.0 * h);
+    let dy = (at(x, y + h) - at(x, y - h)) / (2.0 * h);
+    let (a, b, c) = (dx.dot(dx), dx.dot(dy), dy.dot(dy));
+    ((a + c) / 2.0 + (((a - c) / 2.0).powi(2) + b * b).sqrt()).sqrt()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+    /// `stretch_over` bounds every step between points of its box (their
+    /// geodesic over their face distance) and the Jacobian's norm inside
+    /// it, and is tight on a small box.
+    #[test]
+    fn stretch_over_bounds_every_step_in_its_box(
+        face in 0u8..12,
+        centre in (0.0f64..1.0, 0.0f64..1.0),
+        half in prop_oneof![1e-4f64..1e-2, 1e-2f64..0.6],
+        picks in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), 16),
+    ) {
+        use tessera::healpix::stretch_over;
+        let (cx, cy) = centre;
+        let (x, y) = ([cx - half, cx + half], [cy - half, cy + half]);
+        let bound = stretch_over(face, x, y);
+        prop_assert!(bound <= 1.6);
+        let clamp = |v: [f64; 2]| [v[0].clamp(0.0, 1.0), v[1].clamp(0.0, 1.0)];
+        let (x, y) = (clamp(x), clamp(y));
+        let inside = |u: f64, v: f64| (x[0] + u * (x[1] - x[0]), y[0] + v * (y[1] - y[0]));
+        for &(u0, v0, u1, v1) in &picks {
+            let (p, q) = (inside(u0, v0), inside(u1, v1));
+            let d = angle(FacePoint::new(face, p.0, p.1).to_vec(), FacePoint::new(face, q.0, q.1).to_vec());
+            let on_face = (p.0 - q.0).hypot(p.1 - q.1);
+            prop_assert!(d <= bound * on_face * (1.0 + 1e-9) + 1e-15, "step {d} > {bound} x {on_face}");
+            // away from the pole's corner and the zone seam, where the
+            // differences straddle a kink
+            let corner = (1.0 - p.0) + (1.0 - p.1);
+            if corner > 1e-3 && p.0 + p.1 > 1e-3 {
+                prop_assert!(stretch_at(face, p.0, p.1) <= bound * (1.0 + 1e-6));
+            }
+        }
+        if half < 1e-2 && (x[1] - x[0]).min(y[1] - y[0]) > 0.0 {
+            let (px, py) = inside(0.5, 0.5);
+            let (sigma_n, sigma_s) = (2.0 - px - py, px + py);
+            let sigma = if face < 4 { sigma_n } else { sigma_s };
+            // the `|x - y| / sigma` bound loosens near the pole, and the
+            // Jacobian jumps across the zones' seam (`sigma = 1`)
+            if face / 4 == 1 || (sigma > 0.2 && (sigma - 1.0).abs() > 4.0 * half) {
+                let tight = stretch_at(face, px, py) * (1.0 + 60.0 * half / sigma.min(1.0));
+                prop_assert!(bound <= tight, "bound {bound} on a box of {half} at ({px}, {py})");
+            }
+        }
+    }
+}

@@ -172,7 +172,7 @@ proptest! {
             let centre = random_direction(&mut rng);
             let radius = 10f64.powf(-6.0 + 6.2 * rng.next_f64());
             let c = FacePoint::from_vec(centre);
-            let cap = SphereRegion { centroid: c, radius, face: c.face, cells: [[c.x, c.y]; 5], spill: 0.0, warp: 0.0 };
+            let cap = SphereRegion { centroid: c, radius, face: c.face, cells: [[c.x, c.y]; 5], spill: 0.0, warp: 0.0, stretch: tessera::tiling::sphere::FACE_LIPSCHITZ };
             let bound = map.bound(&cap);
             for _ in 0..24 {
                 // a point at angle <= radius from the centre (often near the rim)

@@ -783,6 +783,9 @@ proptest! {
         let regions = Regions::parse(&["cap:20,40,25,16", "polygon:-10 35,40 30,55 55,20 72,-15 62;4"]).unwrap();
         check(&regions, &region, &inner);
         check(&Rotated::new(regions, seed), &region, &inner);
+        let cap = Cap::new(20.0, 40.0, 25.0, 16.0).unwrap();
+        check(&cap, &region, &inner);
+        check(&Rotated::new(cap, seed), &region, &inner);
     }
 }
 

@@ -2,7 +2,7 @@
 
 use super::{Density, Uniform};
 use crate::healpix::FacePoint;
-use crate::tiling::sphere::SphereRegion;
+use crate::tiling::sphere::{SphereRegion, FACE_LIPSCHITZ};
 use crate::Error;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -155,16 +155,34 @@ impl Cap {
     }
 }
 
-impl Density<SphereRegion> for Cap {
-    fn bound(&self, region: &SphereRegion) -> f64 {
-        let distance = angle_between(self.center, region.center());
-        if distance + region.radius <= self.radius {
+impl Cap {
+    /// The bound over the cap of `radius` at angle `distance` from the
+    /// cap's centre.
+    fn bound_at(&self, distance: f64, radius: f64) -> f64 {
+        if distance + radius <= self.radius {
             self.contrast
-        } else if distance - region.radius > self.radius {
+        } else if distance - radius > self.radius {
             1.0
         } else {
             self.contrast.max(1.0)
         }
+    }
+}
+
+impl Density<SphereRegion> for Cap {
+    fn bound(&self, region: &SphereRegion) -> f64 {
+        self.bound_at(angle_between(self.center, region.center()), region.radius)
+    }
+    fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
+        if region.centroid != inner.centroid {
+            return (self.bound(region), self.bound(inner));
+        }
+        // one centre, two radii
+        let distance = angle_between(self.center, region.center());
+        (
+            self.bound_at(distance, region.radius),
+            self.bound_at(distance, inner.radius),
+        )
     }
     fn average(&self, region: &SphereRegion) -> f64 {
         let distance = angle_between(self.center, region.center());
@@ -496,6 +514,7 @@ impl<D> Rotated<D> {
             cells: [[centre.x, centre.y]; 5],
             spill: 0.0,
             warp: 0.0,
+            stretch: FACE_LIPSCHITZ,
         }
     }
 }
