@@ -736,6 +736,29 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    /// Deep tiles' caps, which follow the face's local stretch, hold their
+    /// samples and their children's with no tolerance, at levels 9-36
+    /// (down to 3e-12 rad across), past `regions_hold_every_sample_they_bound`'s
+    /// levels.
+    #[test]
+    fn deep_caps_hold_their_samples_to_the_last_bit(
+        level in 9u32..=36,
+        pick in 0u128..u128::MAX,
+        fraction in 0.01f64..1.0,
+    ) {
+        let tiling = SphereTiling::default();
+        let tile = tiling.tile_with_code(level, pick % (240u128 << (2 * level))).unwrap();
+        let region = tiling.region(&tile);
+        for t in std::iter::once(tile).chain((0..4).map(|i| tiling.child(&tile, i))) {
+            let s = tiling.sample(&t, fraction);
+            let d = angle_between(s, region.center());
+            prop_assert!(d <= region.radius, "level {level}: {d} past the cap {}", region.radius);
+        }
+    }
+}
+
+proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
     /// `Density::bounds`, which the engine calls where it needs a tile's
     /// bound and its placing bound together, gives exactly the two bounds

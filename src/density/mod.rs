@@ -45,7 +45,7 @@ pub trait Density<R: Region>: Sync {
     /// density above its tile's bound, as its samples would be biased).
     fn bound(&self, region: &R) -> f64;
     /// [`Density::bound`] over `region` and over `inner`, a region inside it
-    /// about the same centre (a tile's placing region,
+    /// (a tile's placing region,
     /// [`crate::tiling::TileSystem::placing_region`]), in one call: the
     /// engine asks for both where it knows it needs both, and a density
     /// whose bound starts from the region's centre or probes computes

@@ -367,7 +367,8 @@ impl<F: Fn(DVec3) -> f64 + Sync> Density<SphereRegion> for SphereFn<F> {
 
     fn bounds(&self, region: &SphereRegion, inner: &SphereRegion) -> (f64, f64) {
         let (reach, inner_reach) = (region.cell_reach(), inner.cell_reach());
-        if reach >= region.radius || inner_reach >= inner.radius || region.cells != inner.cells {
+        let same_probes = region.face == inner.face && region.cells == inner.cells;
+        if reach >= region.radius || inner_reach >= inner.radius || !same_probes {
             return (self.bound(region), self.bound(inner));
         }
         // the same five probes

@@ -474,7 +474,7 @@ impl SphereTiling {
         let stretch = stretch_about(centroid, reach_on_face);
         SphereRegion {
             centroid,
-            radius: stretch * reach_on_face + reach.warp,
+            radius: cap_radius(stretch, reach_on_face) + reach.warp,
             face: tile.face,
             cells: [cell(0), cell(1), cell(2), cell(3), cell(4)],
             spill: reach.past_cells / nside,
@@ -525,6 +525,15 @@ impl SphereTiling {
         }
         reach
     }
+}
+
+/// The radius (rad) of a cap holding every face point within `reach`
+/// (face coordinates) of its centre, `stretch` bounding the stretch
+/// between them. The bound is exact along an equatorial face's diagonal,
+/// so the radius gains a margin for the rounding of computed positions
+/// (about 4e-16 rad, 1e-4 of a level-36 tile's reach).
+fn cap_radius(stretch: f64, reach: f64) -> f64 {
+    stretch * reach * (1.0 + 1e-9) + 8.0 * f64::EPSILON
 }
 
 /// [`crate::healpix::stretch_over`] the box `centroid ± reach`: for the
@@ -773,7 +782,7 @@ impl TileSystem for SphereTiling {
         // pentomino's), with the pentomino's reach
         let nside = Self::nside(tile.level as u32) as f64;
         Some(SphereRegion {
-            radius: region.stretch * PENTOMINO_RADIUS / nside,
+            radius: cap_radius(region.stretch, PENTOMINO_RADIUS / nside),
             spill: 0.0,
             warp: 0.0,
             ..*region
