@@ -34,7 +34,10 @@
 //! than 2x over the region: the candidate's place follows the density no
 //! more than when the bound over the tile's cells was its only bound (up
 //! to session 52), which is what the argument below needs, within the
-//! local bias beside edges that EDGE_BIAS.md measures.
+//! local bias beside edges that EDGE_BIAS.md measures. Where the parent's
+//! bound makes the tile's children terminal, so that `q` will be needed,
+//! `b` and `q` come from one call, [`Density::bounds`], which densities
+//! answer from one centre or one set of probes.
 //!
 //! **Why the expectation is exact.** Under a uniformly random rotation of
 //! the density (a random toroidal shift on the plane), the tile of a given
