@@ -153,9 +153,7 @@ impl Cap {
         let inside = self.contrast * self.solid_angle();
         inside / (inside + 4.0 * PI - self.solid_angle())
     }
-}
 
-impl Cap {
     /// The bound over the cap of `radius` at angle `distance` from the
     /// cap's centre.
     fn bound_at(&self, distance: f64, radius: f64) -> f64 {

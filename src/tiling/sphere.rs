@@ -132,12 +132,11 @@ impl SphereRegion {
     /// nearest of its five cell centres ([`SphereRegion::probes`]): within
     /// `side / 2 + spill` of one in either face coordinate, so within
     /// `sqrt 2` times that, stretched onto the sphere by at most
-    /// [`FACE_LIPSCHITZ`], and then warped. (With the tighter
-    /// [`SphereRegion::stretch`], the bound's looseness would vary over a
-    /// face, and neighbouring tiles of a smooth density take different
-    /// bins: under `2^(4 z)` at N = 10^6, 8 points came within 1.0 local
-    /// spacings of another, the closest 0.92, against none and 1.16.) Infinite for a bare cap (see
-    /// [`SphereRegion::cell_side`]).
+    /// [`FACE_LIPSCHITZ`], and then warped. Not the tighter
+    /// [`SphereRegion::stretch`]: a `SphereFn` bound whose looseness
+    /// varies over the face gives neighbouring tiles different bins, and
+    /// their points crowd (DESIGN.md, Sphere, Region). Infinite for a bare
+    /// cap (see [`SphereRegion::cell_side`]).
     ///
     /// # Example
     /// ```
@@ -565,7 +564,7 @@ fn stretch_about(centroid: FacePoint, reach: f64) -> f64 {
     // the block holding the centroid (clamped onto the face): the box lies
     // within it grown by a block
     let block = |v: f64| ((v * BLOCKS as f64) as usize).min(BLOCKS - 1);
-    let ring = (centroid.face as usize % 12) / 4;
+    let ring = (centroid.face as usize % crate::healpix::FACE_COUNT) / 4;
     grid[(ring * BLOCKS + block(x.clamp(0.0, 1.0))) * BLOCKS + block(y.clamp(0.0, 1.0))]
 }
 
